@@ -1,0 +1,373 @@
+#include "itkMOREAImageIO.h"
+
+#include "itkGDCMImageIO.h"
+#include "itkGDCMSeriesFileNames.h"
+#include "itkImageFileReader.h"
+#include "itkImageFileWriter.h"
+#include "itkImageRegionConstIterator.h"
+#include "itkImageRegionIterator.h"
+#include "itkImageSeriesReader.h"
+
+#include <atomic>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+
+namespace itk
+{
+namespace morea
+{
+namespace
+{
+[[noreturn]] void
+Fail(const std::string & message)
+{
+  itkGenericExceptionMacro(<< message);
+}
+
+template <typename TImage>
+typename TImage::Pointer
+ReadFile(const std::string & path, const std::string & what)
+{
+  if (!fs::exists(path))
+  {
+    Fail(what + " '" + path + "' does not exist");
+  }
+  if (fs::is_directory(path))
+  {
+    Fail(what + " '" + path + "' is a directory, expected an image file");
+  }
+  auto reader = ImageFileReader<TImage>::New();
+  reader->SetFileName(path);
+  try
+  {
+    reader->Update();
+  }
+  catch (const ExceptionObject & e)
+  {
+    Fail("cannot read " + what + " '" + path + "': " + e.GetDescription());
+  }
+  const auto * io = reader->GetImageIO();
+  if (io != nullptr && io->GetNumberOfDimensions() != Dimension)
+  {
+    // ITK pads 2D files to 3D silently; a 2D structure on a 3D problem is an input error.
+    Fail(what + " '" + path + "' has " + std::to_string(io->GetNumberOfDimensions()) + " dimensions, expected 3");
+  }
+  typename TImage::Pointer image = reader->GetOutput();
+  image->DisconnectPipeline();
+  return image;
+}
+
+ImageType::Pointer
+ReadDicomSeries(const std::string & directory)
+{
+  auto names = GDCMSeriesFileNames::New();
+  names->SetUseSeriesDetails(true);
+  names->SetDirectory(directory);
+  const auto & seriesUIDs = names->GetSeriesUIDs();
+  if (seriesUIDs.empty())
+  {
+    Fail("no DICOM image series found in folder '" + directory + "'");
+  }
+  const auto fileNames = names->GetFileNames(seriesUIDs.front());
+  if (fileNames.size() < 2)
+  {
+    Fail("the DICOM series in '" + directory + "' has fewer than 2 slices");
+  }
+  using ReaderType = ImageSeriesReader<ImageType>;
+  auto reader = ReaderType::New();
+  auto dicomIO = GDCMImageIO::New();
+  reader->SetImageIO(dicomIO);
+  reader->SetFileNames(fileNames);
+  try
+  {
+    reader->Update();
+  }
+  catch (const ExceptionObject & e)
+  {
+    Fail("cannot read DICOM series in '" + directory + "': " + e.GetDescription());
+  }
+  ImageType::Pointer image = reader->GetOutput();
+  image->DisconnectPipeline();
+  return image;
+}
+} // namespace
+
+void
+ValidateImage(const ImageBase<Dimension> * image, const std::string & what)
+{
+  if (image == nullptr)
+  {
+    Fail(what + ": no image");
+  }
+  const auto size = image->GetLargestPossibleRegion().GetSize();
+  for (unsigned int d = 0; d < Dimension; ++d)
+  {
+    if (size[d] == 0)
+    {
+      Fail(what + ": image has zero size along axis " + std::to_string(d));
+    }
+    const double s = image->GetSpacing()[d];
+    if (!(s > 0.0) || !std::isfinite(s))
+    {
+      std::ostringstream os;
+      os << what << ": spacing along axis " << d << " is " << s << ", must be positive";
+      Fail(os.str());
+    }
+    if (!std::isfinite(image->GetOrigin()[d]))
+    {
+      Fail(what + ": origin is not finite");
+    }
+  }
+  const double det = vnl_determinant(image->GetDirection().GetVnlMatrix());
+  if (!(std::abs(det) > 1e-6))
+  {
+    Fail(what + ": direction matrix is singular");
+  }
+}
+
+void
+ValidateVoxels(const ImageType * image, const std::string & what)
+{
+  std::size_t bad = 0;
+  ImageRegionConstIterator<ImageType> it(image, image->GetBufferedRegion());
+  for (; !it.IsAtEnd(); ++it)
+  {
+    if (!std::isfinite(it.Get()))
+    {
+      ++bad;
+    }
+  }
+  if (bad > 0)
+  {
+    Fail(what + ": " + std::to_string(bad) + " voxels are NaN or infinite");
+  }
+}
+
+bool
+SameGrid(const ImageBase<Dimension> * a, const ImageBase<Dimension> * b, double tolerance)
+{
+  if (a->GetLargestPossibleRegion().GetSize() != b->GetLargestPossibleRegion().GetSize())
+  {
+    return false;
+  }
+  for (unsigned int i = 0; i < Dimension; ++i)
+  {
+    const double s = a->GetSpacing()[i];
+    if (std::abs(s - b->GetSpacing()[i]) > tolerance * s ||
+        std::abs(a->GetOrigin()[i] - b->GetOrigin()[i]) > tolerance * s)
+    {
+      return false;
+    }
+    for (unsigned int j = 0; j < Dimension; ++j)
+    {
+      if (std::abs(a->GetDirection()[i][j] - b->GetDirection()[i][j]) > tolerance)
+      {
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+ImageType::Pointer
+ReadImage(const std::string & path)
+{
+  ImageType::Pointer image =
+    fs::is_directory(path) ? ReadDicomSeries(path) : ReadFile<ImageType>(path, "image");
+  ValidateImage(image, "image '" + path + "'");
+  ValidateVoxels(image, "image '" + path + "'");
+  return image;
+}
+
+LabelMapType::Pointer
+ReadLabelMap(const std::string & path)
+{
+  auto labels = ReadFile<LabelMapType>(path, "label map");
+  ValidateImage(labels, "label map '" + path + "'");
+  return labels;
+}
+
+MaskType::Pointer
+ReadMask(const std::string & path)
+{
+  // Read as float so that masks stored as probabilities or with NaN are caught.
+  auto raw = ReadFile<ImageType>(path, "mask");
+  ValidateImage(raw, "mask '" + path + "'");
+  ValidateVoxels(raw, "mask '" + path + "'");
+  auto mask = MaskType::New();
+  mask->CopyInformation(raw);
+  mask->SetRegions(raw->GetLargestPossibleRegion());
+  mask->Allocate();
+  std::size_t inside = 0;
+  ImageRegionConstIterator<ImageType> in(raw, raw->GetLargestPossibleRegion());
+  ImageRegionIterator<MaskType>       out(mask, mask->GetLargestPossibleRegion());
+  for (; !in.IsAtEnd(); ++in, ++out)
+  {
+    const bool on = in.Get() != 0.0f;
+    out.Set(on ? 1 : 0);
+    inside += on;
+  }
+  if (inside == 0)
+  {
+    Fail("mask '" + path + "' is empty (no non-zero voxel)");
+  }
+  return mask;
+}
+
+MaskType::Pointer
+ExtractLabel(const LabelMapType * labelMap, unsigned int label, const std::string & what)
+{
+  auto mask = MaskType::New();
+  mask->CopyInformation(labelMap);
+  mask->SetRegions(labelMap->GetLargestPossibleRegion());
+  mask->Allocate();
+  std::size_t inside = 0;
+  ImageRegionConstIterator<LabelMapType> in(labelMap, labelMap->GetLargestPossibleRegion());
+  ImageRegionIterator<MaskType>          out(mask, mask->GetLargestPossibleRegion());
+  for (; !in.IsAtEnd(); ++in, ++out)
+  {
+    const bool on = in.Get() == label;
+    out.Set(on ? 1 : 0);
+    inside += on;
+  }
+  if (inside == 0)
+  {
+    Fail(what + ": label " + std::to_string(label) + " is absent from the label map");
+  }
+  return mask;
+}
+
+std::map<std::string, unsigned int>
+ReadLabelNames(const std::string & path)
+{
+  std::ifstream in(path);
+  if (!in)
+  {
+    Fail("cannot open label description file '" + path + "'");
+  }
+  std::map<std::string, unsigned int> names;
+  std::string                         line;
+  int                                 lineNumber = 0;
+  while (std::getline(in, line))
+  {
+    ++lineNumber;
+    const auto hash = line.find('#');
+    if (hash != std::string::npos)
+    {
+      line.erase(hash);
+    }
+    std::istringstream fields(line);
+    long               value = 0;
+    std::string        name;
+    if (!(fields >> value))
+    {
+      if (line.find_first_not_of(" \t\r") == std::string::npos)
+      {
+        continue;
+      }
+      Fail("label description file '" + path + "' line " + std::to_string(lineNumber) + ": expected '<value> <name>'");
+    }
+    if (!(fields >> name) || value <= 0 || value > 65535)
+    {
+      Fail("label description file '" + path + "' line " + std::to_string(lineNumber) +
+           ": expected a label value in 1..65535 and a name");
+    }
+    names[name] = static_cast<unsigned int>(value);
+  }
+  return names;
+}
+
+std::string
+TemporaryPathFor(const std::string & finalPath)
+{
+  static std::atomic<unsigned> counter{ 0 };
+  const fs::path p(finalPath);
+  std::string    name = p.filename().string();
+  // Keep the whole extension chain (".nii.gz") so ITK selects the same IO.
+  const auto     dot = name.find('.', 1);
+  const std::string stem = dot == std::string::npos ? name : name.substr(0, dot);
+  const std::string ext = dot == std::string::npos ? "" : name.substr(dot);
+  const std::string tmp = "." + stem + ".tmp" + std::to_string(::getpid()) + "_" + std::to_string(counter++) + ext;
+  return (p.parent_path() / tmp).string();
+}
+
+void
+CommitFile(const std::string & temporaryPath, const std::string & finalPath)
+{
+  std::error_code ec;
+  fs::rename(temporaryPath, finalPath, ec);
+  if (ec)
+  {
+    fs::remove(temporaryPath, ec);
+    Fail("cannot move '" + temporaryPath + "' to '" + finalPath + "'");
+  }
+}
+
+namespace
+{
+template <typename TImage>
+void
+WriteFileAtomically(const TImage * image, const std::string & path)
+{
+  const fs::path parent = fs::path(path).parent_path();
+  if (!parent.empty())
+  {
+    std::error_code ec;
+    fs::create_directories(parent, ec);
+    if (ec)
+    {
+      Fail("cannot create folder '" + parent.string() + "': " + ec.message());
+    }
+  }
+  const std::string tmp = TemporaryPathFor(path);
+  auto              writer = ImageFileWriter<TImage>::New();
+  writer->SetInput(image);
+  writer->SetFileName(tmp);
+  writer->SetUseCompression(true);
+  try
+  {
+    writer->Update();
+  }
+  catch (const ExceptionObject & e)
+  {
+    std::error_code ec;
+    fs::remove(tmp, ec);
+    Fail("cannot write '" + path + "': " + e.GetDescription());
+  }
+  CommitFile(tmp, path);
+}
+} // namespace
+
+void
+WriteImage(const ImageType * image, const std::string & path)
+{
+  WriteFileAtomically(image, path);
+}
+
+void
+WriteMask(const MaskType * mask, const std::string & path)
+{
+  WriteFileAtomically(mask, path);
+}
+
+void
+WriteDisplacementField(const DisplacementFieldType * field, const std::string & path)
+{
+  WriteFileAtomically(field, path);
+}
+
+DisplacementFieldType::Pointer
+ReadDisplacementField(const std::string & path)
+{
+  auto field = ReadFile<DisplacementFieldType>(path, "displacement field");
+  ValidateImage(field, "displacement field '" + path + "'");
+  return field;
+}
+
+} // namespace morea
+} // namespace itk
