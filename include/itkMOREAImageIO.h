@@ -60,6 +60,10 @@ WriteMask(const MaskType * mask, const std::string & path);
 void
 WriteDisplacementField(const DisplacementFieldType * field, const std::string & path);
 
+/** Writes text atomically (temporary name, then rename); creates parent folders. */
+void
+WriteTextFile(const std::string & text, const std::string & path);
+
 /** Reads a displacement field (vector image with 3 components, mm). */
 DisplacementFieldType::Pointer
 ReadDisplacementField(const std::string & path);

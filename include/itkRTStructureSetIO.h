@@ -22,8 +22,9 @@ struct RTStructureROI
 };
 
 /** Reads every ROI (name, number, closed-planar contours) of an RTSTRUCT file
- *  with DCMTK's dcmrt. Throws an ExceptionObject naming the file when it
- *  cannot be read or is not an RT Structure Set. */
+ *  with DCMTK's dcmrt; POINT and open contours are skipped. `path` may also be a
+ *  folder holding exactly one RTSTRUCT file. Throws an ExceptionObject naming the
+ *  file when it cannot be read, is not an RT Structure Set or defines no ROI. */
 std::vector<RTStructureROI>
 ReadRTStructureSet(const std::string & path);
 

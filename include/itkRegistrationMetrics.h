@@ -12,6 +12,7 @@
 
 #include "itkMOREATypes.h"
 
+#include <cstddef>
 #include <vector>
 
 namespace itk
@@ -59,6 +60,8 @@ struct InverseConsistencyScores
 {
   double mean{ 0.0 };
   double maximum{ 0.0 };
+  std::size_t evaluatedPoints{ 0 }; ///< voxels scored
+  std::size_t pointsOutside{ 0 };   ///< voxels skipped: x + u(x) left the moving field's grid
 };
 InverseConsistencyScores
 ComputeInverseConsistency(const DisplacementFieldType * fixedToMoving,

@@ -1,1 +1,39 @@
-int main(){return 0;}
+// The `morea` command line: multi-objective deformable registration (MOREA).
+#include "CommandCommon.h"
+
+#include "itkMacro.h"
+#include "morea/Error.h"
+
+#include <iostream>
+
+int
+main(int argc, char ** argv)
+{
+  CLI::App app{ "morea: multi-objective deformable registration of 3D images with large deformations" };
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "morea 0.1.0");
+  morea::cli::AddPhantomCommand(app);
+  morea::cli::AddPreprocessCommand(app);
+  morea::cli::AddEvaluateCommand(app);
+  morea::cli::AddDemoCommand(app);
+  morea::cli::AddInfoCommand(app);
+  try
+  {
+    app.parse(argc, argv);
+  }
+  catch (const CLI::ParseError & e)
+  {
+    return app.exit(e);
+  }
+  catch (const itk::ExceptionObject & e)
+  {
+    std::cerr << "morea: error: " << e.GetDescription() << "\n";
+    return 1;
+  }
+  catch (const std::exception & e)
+  {
+    std::cerr << "morea: error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

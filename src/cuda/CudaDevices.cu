@@ -1,1 +1,56 @@
-// (being written)
+// Device discovery through the CUDA runtime. No ITK here.
+#include "morea/ComputeDevices.h"
+
+#include <cuda_runtime.h>
+
+namespace morea
+{
+bool
+BuiltWithCuda()
+{
+  return true;
+}
+
+std::vector<CudaDeviceInfo>
+ListCudaDevices()
+{
+  int count = 0;
+  if (cudaGetDeviceCount(&count) != cudaSuccess)
+  {
+    cudaGetLastError(); // clear the sticky "no device/driver" error
+    return {};
+  }
+  std::vector<CudaDeviceInfo> devices;
+  for (int i = 0; i < count; ++i)
+  {
+    cudaDeviceProp prop{};
+    if (cudaGetDeviceProperties(&prop, i) != cudaSuccess)
+    {
+      cudaGetLastError();
+      continue;
+    }
+    CudaDeviceInfo info;
+    info.ordinal = i;
+    info.name = prop.name;
+    info.computeCapabilityMajor = prop.major;
+    info.computeCapabilityMinor = prop.minor;
+    info.totalMemoryBytes = prop.totalGlobalMem;
+    info.multiprocessors = prop.multiProcessorCount;
+    devices.push_back(info);
+  }
+  return devices;
+}
+
+std::string
+CudaUnavailableReason()
+{
+  int               count = 0;
+  const cudaError_t status = cudaGetDeviceCount(&count);
+  if (status != cudaSuccess)
+  {
+    cudaGetLastError();
+    return std::string("no usable CUDA device: ") + cudaGetErrorString(status);
+  }
+  return count == 0 ? "no CUDA device present" : "";
+}
+} // namespace morea

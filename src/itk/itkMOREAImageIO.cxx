@@ -361,6 +361,28 @@ WriteDisplacementField(const DisplacementFieldType * field, const std::string & 
   WriteFileAtomically(field, path);
 }
 
+void
+WriteTextFile(const std::string & text, const std::string & path)
+{
+  const fs::path  parent = fs::path(path).parent_path();
+  std::error_code ec;
+  if (!parent.empty())
+  {
+    fs::create_directories(parent, ec);
+  }
+  const std::string tmp = TemporaryPathFor(path);
+  {
+    std::ofstream out(tmp, std::ios::binary);
+    out << text;
+    if (!out.flush())
+    {
+      fs::remove(tmp, ec);
+      Fail("cannot write '" + path + "'");
+    }
+  }
+  CommitFile(tmp, path);
+}
+
 DisplacementFieldType::Pointer
 ReadDisplacementField(const std::string & path)
 {

@@ -1,1 +1,480 @@
-// (being written)
+#include "itkPreprocessing.h"
+
+#include "itkImageRegionConstIterator.h"
+#include "itkImageRegionConstIteratorWithIndex.h"
+#include "itkImageRegionIterator.h"
+#include "itkLinearInterpolateImageFunction.h"
+#include "itkMOREAImageIO.h"
+#include "itkRegionOfInterestImageFilter.h"
+#include "itkResampleImageFilter.h"
+#include "itkSignedMaurerDistanceMapImageFilter.h"
+#include "morea/ParameterSet.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+namespace itk
+{
+namespace morea
+{
+namespace
+{
+[[noreturn]] void
+Fail(const std::string & message)
+{
+  itkGenericExceptionMacro(<< message);
+}
+
+std::size_t
+CountInside(const MaskType * mask)
+{
+  std::size_t                        n = 0;
+  ImageRegionConstIterator<MaskType> it(mask, mask->GetBufferedRegion());
+  for (; !it.IsAtEnd(); ++it)
+    n += it.Get() != 0;
+  return n;
+}
+
+/** Index box of the non-zero voxels; false when there are none. */
+bool
+InsideIndexBox(const MaskType * mask, MaskType::IndexType & lo, MaskType::IndexType & hi)
+{
+  bool any = false;
+  for (unsigned d = 0; d < Dimension; ++d)
+  {
+    lo[d] = std::numeric_limits<IndexValueType>::max();
+    hi[d] = std::numeric_limits<IndexValueType>::lowest();
+  }
+  ImageRegionConstIteratorWithIndex<MaskType> it(mask, mask->GetBufferedRegion());
+  for (; !it.IsAtEnd(); ++it)
+  {
+    if (it.Get() == 0)
+      continue;
+    any = true;
+    const auto idx = it.GetIndex();
+    for (unsigned d = 0; d < Dimension; ++d)
+    {
+      lo[d] = std::min(lo[d], idx[d]);
+      hi[d] = std::max(hi[d], idx[d]);
+    }
+  }
+  return any;
+}
+
+ImageType::Pointer
+SignedDistance(const MaskType * mask)
+{
+  auto filter = SignedMaurerDistanceMapImageFilter<MaskType, ImageType>::New();
+  filter->SetInput(mask);
+  filter->SetInsideIsPositive(false);
+  filter->SetSquaredDistance(false);
+  filter->SetUseImageSpacing(true);
+  filter->SetBackgroundValue(0);
+  filter->Update();
+  return filter->GetOutput();
+}
+
+/** A level set whose zero crossing lies on the voxel faces between inside and
+ *  outside voxels (half-way, whatever the spacing along that axis): half the
+ *  difference of the distance maps of the mask and of its complement. */
+ImageType::Pointer
+FaceCenteredLevelSet(const MaskType * mask)
+{
+  auto complement = MaskType::New();
+  complement->CopyInformation(mask);
+  complement->SetRegions(mask->GetBufferedRegion());
+  complement->Allocate();
+  ImageRegionConstIterator<MaskType> in(mask, mask->GetBufferedRegion());
+  ImageRegionIterator<MaskType>      out(complement, complement->GetBufferedRegion());
+  for (; !in.IsAtEnd(); ++in, ++out)
+    out.Set(in.Get() != 0 ? 0 : 1);
+  auto inside = SignedDistance(mask);
+  auto outside = SignedDistance(complement);
+  ImageRegionIterator<ImageType>      a(inside, inside->GetBufferedRegion());
+  ImageRegionConstIterator<ImageType> b(outside, outside->GetBufferedRegion());
+  for (; !a.IsAtEnd(); ++a, ++b)
+    a.Set(0.5f * (a.Get() - b.Get()));
+  return inside;
+}
+
+template <typename TImage>
+typename TImage::Pointer
+MakeImageOn(const ImageBase<Dimension> * grid)
+{
+  auto image = TImage::New();
+  image->SetOrigin(grid->GetOrigin());
+  image->SetSpacing(grid->GetSpacing());
+  image->SetDirection(grid->GetDirection());
+  image->SetRegions(grid->GetLargestPossibleRegion());
+  image->Allocate();
+  return image;
+}
+
+ImageType::Pointer
+ResampleLinear(const ImageType * image, const ImageBase<Dimension> * grid, const RigidTransformType * gridToImage,
+               float defaultValue)
+{
+  using FilterType = ResampleImageFilter<ImageType, ImageType>;
+  auto filter = FilterType::New();
+  filter->SetInput(image);
+  filter->SetOutputParametersFromImage(grid);
+  if (gridToImage != nullptr)
+    filter->SetTransform(gridToImage);
+  filter->SetInterpolator(LinearInterpolateImageFunction<ImageType, double>::New());
+  filter->SetDefaultPixelValue(defaultValue);
+  filter->Update();
+  return filter->GetOutput();
+}
+
+bool
+IsBodyName(std::string name)
+{
+  std::transform(name.begin(), name.end(), name.begin(), ::tolower);
+  return name == "body" || name == "external" || name == "skin";
+}
+
+double
+SecondsSince(std::chrono::steady_clock::time_point start)
+{
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+} // namespace
+
+PreprocessOptions
+PreprocessOptions::FromParameters(const ::morea::ParameterSet & p)
+{
+  PreprocessOptions o;
+  o.isotropicSpacing = p.GetReal("preprocess_isotropic_spacing");
+  o.rigidStructure = p.GetString("preprocess_rigid_structure");
+  o.cropStructure = p.GetString("preprocess_crop_structure");
+  o.cropMargin = p.GetReal("preprocess_crop_margin");
+  o.windowMin = static_cast<float>(p.GetReal("preprocess_intensity_min"));
+  o.windowMax = static_cast<float>(p.GetReal("preprocess_intensity_max"));
+  o.fieldOfViewThreshold = static_cast<float>(p.GetReal("preprocess_fov_threshold"));
+  return o;
+}
+
+ImageType::Pointer
+ResampleIsotropic(const ImageType * image, double spacing)
+{
+  if (!(spacing > 0.0))
+    Fail("isotropic spacing must be positive");
+  auto       grid = ImageType::New();
+  const auto size = image->GetLargestPossibleRegion().GetSize();
+  ImageType::SizeType outSize;
+  ImageType::SpacingType outSpacing;
+  for (unsigned d = 0; d < Dimension; ++d)
+  {
+    const double extent = image->GetSpacing()[d] * static_cast<double>(size[d]);
+    outSize[d] = std::max<SizeValueType>(1, static_cast<SizeValueType>(std::floor(extent / spacing + 1e-6)));
+    outSpacing[d] = spacing;
+  }
+  // Keep the outer edge of the first voxel where it was.
+  ImageType::PointType origin;
+  ContinuousIndex<double, Dimension> firstEdge;
+  for (unsigned d = 0; d < Dimension; ++d)
+    firstEdge[d] = -0.5 + 0.5 * spacing / image->GetSpacing()[d];
+  image->TransformContinuousIndexToPhysicalPoint(firstEdge, origin);
+  grid->SetOrigin(origin);
+  grid->SetSpacing(outSpacing);
+  grid->SetDirection(image->GetDirection());
+  grid->SetRegions(ImageType::RegionType(outSize));
+  return ResampleLinear(image, grid, nullptr, 0.0f);
+}
+
+MaskType::Pointer
+ResampleMask(const MaskType * mask, const ImageBase<Dimension> * grid, const RigidTransformType * gridToMask)
+{
+  auto                output = MakeImageOn<MaskType>(grid);
+  MaskType::IndexType lo, hi;
+  if (!InsideIndexBox(mask, lo, hi))
+  {
+    output->FillBuffer(0);
+    return output;
+  }
+  // Work on the mask's bounding box (plus a border) only: distance maps are the cost.
+  const auto          full = mask->GetLargestPossibleRegion();
+  MaskType::IndexType start;
+  MaskType::SizeType  size;
+  for (unsigned d = 0; d < Dimension; ++d)
+  {
+    start[d] = std::max<IndexValueType>(full.GetIndex()[d], lo[d] - 3);
+    const IndexValueType end =
+      std::min<IndexValueType>(full.GetIndex()[d] + static_cast<IndexValueType>(full.GetSize()[d]) - 1, hi[d] + 3);
+    size[d] = static_cast<SizeValueType>(end - start[d] + 1);
+  }
+  auto roi = RegionOfInterestImageFilter<MaskType, MaskType>::New();
+  roi->SetInput(mask);
+  roi->SetRegionOfInterest(MaskType::RegionType(start, size));
+  roi->Update();
+  auto level = FaceCenteredLevelSet(roi->GetOutput());
+  auto resampled = ResampleLinear(level, grid, gridToMask, std::numeric_limits<float>::max());
+  ImageRegionConstIterator<ImageType> in(resampled, resampled->GetBufferedRegion());
+  ImageRegionIterator<MaskType>       out(output, output->GetBufferedRegion());
+  for (; !in.IsAtEnd(); ++in, ++out)
+    out.Set(in.Get() <= 0.0f ? 1 : 0);
+  return output;
+}
+
+void
+MaskBoundingBox(const MaskType * mask, PointType & lower, PointType & upper, const RigidTransformType * frameToMask)
+{
+  MaskType::IndexType lo, hi;
+  if (!InsideIndexBox(mask, lo, hi))
+    Fail("cannot take the bounding box of an empty mask");
+  RigidTransformType::InverseTransformBasePointer maskToFrame;
+  if (frameToMask != nullptr)
+    maskToFrame = frameToMask->GetInverseTransform();
+  for (unsigned d = 0; d < Dimension; ++d)
+  {
+    lower[d] = std::numeric_limits<double>::max();
+    upper[d] = std::numeric_limits<double>::lowest();
+  }
+  for (unsigned corner = 0; corner < 8; ++corner)
+  {
+    ContinuousIndex<double, Dimension> index;
+    for (unsigned d = 0; d < Dimension; ++d)
+      index[d] = (corner >> d & 1) ? hi[d] + 0.5 : lo[d] - 0.5;
+    PointType p;
+    mask->TransformContinuousIndexToPhysicalPoint(index, p);
+    if (maskToFrame)
+      p = maskToFrame->TransformPoint(p);
+    for (unsigned d = 0; d < Dimension; ++d)
+    {
+      lower[d] = std::min(lower[d], p[d]);
+      upper[d] = std::max(upper[d], p[d]);
+    }
+  }
+}
+
+std::string
+LargestDeformingStructure(const RegistrationProblem & problem)
+{
+  std::string best;
+  double      bestRatio = 0.0;
+  for (const auto & s : problem.structures)
+  {
+    if (IsBodyName(s.name) || s.fixedMask.IsNull() || s.movingMask.IsNull())
+      continue;
+    const auto   volume = [](const MaskType * m) {
+      const auto & sp = m->GetSpacing();
+      return static_cast<double>(CountInside(m)) * sp[0] * sp[1] * sp[2];
+    };
+    const double vf = volume(s.fixedMask);
+    const double vm = volume(s.movingMask);
+    const double ratio = std::max(vf, vm) / std::max(1e-9, std::min(vf, vm));
+    if (ratio > bestRatio)
+    {
+      bestRatio = ratio;
+      best = s.name;
+    }
+  }
+  return best;
+}
+
+ImageType::Pointer
+ApplyIntensityWindow(const ImageType * image, const MaskType * foreground, float windowMin, float windowMax)
+{
+  if (!(windowMax > windowMin))
+    Fail("intensity window maximum must exceed its minimum");
+  if (foreground != nullptr && !SameGrid(image, foreground))
+    Fail("intensity window: the foreground mask is not on the image grid");
+  auto                                output = MakeImageOn<ImageType>(image);
+  const float                         scale = (1.0f - ForegroundFloor) / (windowMax - windowMin);
+  ImageRegionConstIterator<ImageType> in(image, image->GetBufferedRegion());
+  ImageRegionIterator<ImageType>      out(output, output->GetBufferedRegion());
+  if (foreground == nullptr)
+  {
+    for (; !in.IsAtEnd(); ++in, ++out)
+      out.Set(ForegroundFloor + (std::clamp(in.Get(), windowMin, windowMax) - windowMin) * scale);
+    return output;
+  }
+  ImageRegionConstIterator<MaskType> fg(foreground, foreground->GetBufferedRegion());
+  for (; !in.IsAtEnd(); ++in, ++out, ++fg)
+    out.Set(fg.Get() != 0 ? ForegroundFloor + (std::clamp(in.Get(), windowMin, windowMax) - windowMin) * scale : 0.0f);
+  return output;
+}
+
+PointListType
+ExtractSurfacePoints(const MaskType * mask)
+{
+  PointListType                                points;
+  const auto                                   region = mask->GetBufferedRegion();
+  ImageRegionConstIteratorWithIndex<MaskType> it(mask, region);
+  for (; !it.IsAtEnd(); ++it)
+  {
+    if (it.Get() == 0)
+      continue;
+    const auto idx = it.GetIndex();
+    bool       surface = false;
+    for (unsigned d = 0; d < Dimension && !surface; ++d)
+      for (int step : { -1, 1 })
+      {
+        auto n = idx;
+        n[d] += step;
+        if (!region.IsInside(n) || mask->GetPixel(n) == 0)
+        {
+          surface = true;
+          break;
+        }
+      }
+    if (surface)
+    {
+      PointType p;
+      mask->TransformIndexToPhysicalPoint(idx, p);
+      points.push_back(p);
+    }
+  }
+  return points;
+}
+
+PreprocessResult
+Preprocess(const RegistrationProblem & input, const PreprocessOptions & options)
+{
+  const auto start = std::chrono::steady_clock::now();
+  input.Validate();
+  if (!(options.isotropicSpacing > 0.0))
+    Fail("preprocessing: isotropic spacing must be positive");
+  if (!(options.windowMax > options.windowMin))
+    Fail("preprocessing: the intensity window maximum must exceed its minimum");
+  PreprocessResult result;
+  auto &           report = result.report;
+
+  // 1. Rigid pre-alignment (moving onto fixed) on the chosen structure.
+  auto rigid = RigidTransformType::New();
+  rigid->SetIdentity();
+  if (!options.rigidStructure.empty() && options.rigidStructure != "none")
+  {
+    const Structure & s = input.GetStructure(options.rigidStructure);
+    if (s.fixedMask.IsNull() || s.movingMask.IsNull())
+      Fail("rigid pre-alignment structure '" + s.name + "' needs masks on both images");
+    rigid = AlignRigidly(s.fixedMask, s.movingMask, RigidAlignmentOptions{}, &report.rigid);
+    report.rigidStructure = s.name;
+  }
+  result.rigidTransform = rigid;
+
+  // 2. The crop box, in the fixed frame: union of the structure's boxes on both images, plus the margin.
+  PointType lower, upper;
+  {
+    const auto & fixedRegion = input.fixedImage->GetLargestPossibleRegion();
+    PointType    imageLower, imageUpper;
+    auto         fixedAll = MaskType::New();
+    fixedAll->CopyInformation(input.fixedImage);
+    fixedAll->SetRegions(fixedRegion);
+    fixedAll->Allocate();
+    fixedAll->FillBuffer(1);
+    MaskBoundingBox(fixedAll, imageLower, imageUpper);
+    lower = imageLower;
+    upper = imageUpper;
+    report.cropStructure = options.cropStructure.empty() ? LargestDeformingStructure(input) : options.cropStructure;
+    if (!report.cropStructure.empty())
+    {
+      const Structure & s = input.GetStructure(report.cropStructure);
+      if (s.fixedMask.IsNull() || s.movingMask.IsNull())
+        Fail("crop structure '" + s.name + "' needs masks on both images");
+      PointType fl, fu, ml, mu;
+      MaskBoundingBox(s.fixedMask, fl, fu);
+      MaskBoundingBox(s.movingMask, ml, mu, rigid);
+      for (unsigned d = 0; d < Dimension; ++d)
+      {
+        lower[d] = std::max(imageLower[d], std::min(fl[d], ml[d]) - options.cropMargin);
+        upper[d] = std::min(imageUpper[d], std::max(fu[d], mu[d]) + options.cropMargin);
+      }
+    }
+  }
+
+  // 3. One isotropic, axis-aligned grid for both images.
+  auto                   grid = ImageType::New();
+  ImageType::SizeType    size;
+  ImageType::SpacingType spacing;
+  ImageType::PointType   origin;
+  for (unsigned d = 0; d < Dimension; ++d)
+  {
+    spacing[d] = options.isotropicSpacing;
+    size[d] = std::max<SizeValueType>(1, static_cast<SizeValueType>(std::floor((upper[d] - lower[d]) / spacing[d] + 1e-6)));
+    origin[d] = lower[d] + 0.5 * spacing[d];
+  }
+  grid->SetSpacing(spacing);
+  grid->SetOrigin(origin);
+  grid->SetRegions(ImageType::RegionType(size));
+  report.size = size;
+  report.spacing = options.isotropicSpacing;
+  report.origin = origin;
+
+  // 4. Images: one interpolation each; outside the original image is outside the field of view.
+  const float outside = options.fieldOfViewThreshold - 1.0f;
+  auto        fixedRaw = ResampleLinear(input.fixedImage, grid, nullptr, outside);
+  auto        movingRaw = ResampleLinear(input.movingImage, grid, rigid, outside);
+
+  const auto foregroundOf = [&](const ImageType * raw, const MaskType * bodyMask, const Structure * body,
+                                bool fixedSide) {
+    MaskType::Pointer fg = MakeImageOn<MaskType>(grid);
+    MaskType::Pointer bodyOnGrid;
+    const MaskType *  bodySource = bodyMask != nullptr ? bodyMask
+                                   : body != nullptr   ? (fixedSide ? body->fixedMask.GetPointer() : body->movingMask.GetPointer())
+                                                       : nullptr;
+    if (bodySource != nullptr)
+      bodyOnGrid = ResampleMask(bodySource, grid, fixedSide ? nullptr : rigid.GetPointer());
+    ImageRegionConstIterator<ImageType> in(raw, raw->GetBufferedRegion());
+    ImageRegionIterator<MaskType>       out(fg, fg->GetBufferedRegion());
+    for (; !in.IsAtEnd(); ++in, ++out)
+    {
+      bool on = in.Get() >= options.fieldOfViewThreshold;
+      if (on && bodyOnGrid)
+        on = bodyOnGrid->GetPixel(out.GetIndex()) != 0;
+      out.Set(on ? 1 : 0);
+    }
+    return fg;
+  };
+  const Structure * body = nullptr;
+  for (const auto & s : input.structures)
+    if (IsBodyName(s.name) && s.fixedMask && s.movingMask)
+      body = &s;
+  auto fixedForeground = foregroundOf(fixedRaw, input.fixedBodyMask, body, true);
+  auto movingForeground = foregroundOf(movingRaw, input.movingBodyMask, body, false);
+
+  RegistrationProblem & out = result.problem;
+  out.fixedImage = ApplyIntensityWindow(fixedRaw, fixedForeground, options.windowMin, options.windowMax);
+  out.movingImage = ApplyIntensityWindow(movingRaw, movingForeground, options.windowMin, options.windowMax);
+  out.fixedBodyMask = fixedForeground;
+  out.movingBodyMask = movingForeground;
+
+  // 5. Structures: masks on the grid, surface points from the 3D masks.
+  const auto movingToFrame = rigid->GetInverseTransform();
+  for (const auto & s : input.structures)
+  {
+    Structure t;
+    t.name = s.name;
+    if (s.fixedMask)
+      t.fixedMask = ResampleMask(s.fixedMask, grid);
+    if (s.movingMask)
+      t.movingMask = ResampleMask(s.movingMask, grid, rigid);
+    const bool emptyFixed = t.fixedMask ? CountInside(t.fixedMask) == 0 : s.fixedPoints.empty();
+    const bool emptyMoving = t.movingMask ? CountInside(t.movingMask) == 0 : s.movingPoints.empty();
+    if (emptyFixed || emptyMoving)
+    {
+      report.droppedStructures.push_back(s.name);
+      continue;
+    }
+    t.fixedPoints = t.fixedMask ? ExtractSurfacePoints(t.fixedMask) : s.fixedPoints;
+    if (t.movingMask)
+      t.movingPoints = ExtractSurfacePoints(t.movingMask);
+    else
+      for (const auto & p : s.movingPoints)
+        t.movingPoints.push_back(movingToFrame->TransformPoint(p));
+    out.structures.push_back(std::move(t));
+  }
+
+  // 6. Landmarks in the common frame.
+  out.fixedLandmarks = input.fixedLandmarks;
+  for (const auto & p : input.movingLandmarks)
+    out.movingLandmarks.push_back(movingToFrame->TransformPoint(p));
+
+  report.secondsTotal = SecondsSince(start);
+  return result;
+}
+
+} // namespace morea
+} // namespace itk

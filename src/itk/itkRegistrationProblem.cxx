@@ -1,1 +1,283 @@
-// (being written)
+#include "itkRegistrationProblem.h"
+
+#include "itkImageRegionConstIterator.h"
+#include "itkLandmarkIO.h"
+#include "itkMOREAImageIO.h"
+#include "itkPreprocessing.h"
+#include "itkRTStructureSetIO.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+
+namespace fs = std::filesystem;
+
+namespace itk
+{
+namespace morea
+{
+namespace
+{
+[[noreturn]] void
+Fail(const std::string & message)
+{
+  itkGenericExceptionMacro(<< message);
+}
+
+bool
+IsDicomFile(const std::string & path)
+{
+  std::ifstream in(path, std::ios::binary);
+  char          magic[4]{};
+  in.seekg(128);
+  return in.read(magic, 4) && std::equal(magic, magic + 4, "DICM");
+}
+
+bool
+IsPointFile(const std::string & path)
+{
+  const std::string ext = fs::path(path).extension().string();
+  if (ext == ".csv")
+    return true;
+  if (ext != ".txt" && ext != ".pts")
+    return false;
+  std::ifstream in(path);
+  std::string   first;
+  in >> first;
+  return first == "point" || first == "index";
+}
+
+/** Splits "path:selector" where path exists; the selector may be empty. */
+void
+SplitSource(const std::string & source, std::string & path, std::string & selector)
+{
+  path = source;
+  selector.clear();
+  if (fs::exists(source))
+    return;
+  const auto colon = source.rfind(':');
+  if (colon != std::string::npos && colon > 0)
+  {
+    path = source.substr(0, colon);
+    selector = source.substr(colon + 1);
+  }
+  if (!fs::exists(path))
+    Fail("structure source '" + path + "' does not exist");
+}
+
+std::size_t
+CountInside(const MaskType * mask)
+{
+  std::size_t                           n = 0;
+  ImageRegionConstIterator<MaskType> it(mask, mask->GetLargestPossibleRegion());
+  for (; !it.IsAtEnd(); ++it)
+    n += it.Get() != 0;
+  return n;
+}
+
+const char *
+SideName(bool fixedSide)
+{
+  return fixedSide ? "fixed" : "moving";
+}
+} // namespace
+
+void
+RegistrationProblem::LoadImages(const std::string & fixedPath, const std::string & movingPath)
+{
+  fixedImage = ReadImage(fixedPath);
+  movingImage = ReadImage(movingPath);
+}
+
+MaskType::Pointer
+RegistrationProblem::LoadMask(const std::string & source, const ImageType * grid, PointListType * contourPoints) const
+{
+  std::string path, selector;
+  SplitSource(source, path, selector);
+  MaskType::Pointer mask;
+  if (IsDicomFile(path) && !selector.empty())
+  {
+    const auto   rois = ReadRTStructureSet(path);
+    const auto & roi = FindROI(rois, selector);
+    mask = RasterizeROI(roi, grid);
+    if (contourPoints != nullptr)
+      *contourPoints = ContourPoints(roi);
+    return mask;
+  }
+  if (!selector.empty())
+  {
+    auto         labels = ReadLabelMap(path);
+    unsigned int value = 0;
+    const bool   numeric = !selector.empty() && std::all_of(selector.begin(), selector.end(), ::isdigit);
+    if (numeric)
+    {
+      value = static_cast<unsigned int>(std::stoul(selector));
+    }
+    else
+    {
+      // labels.mha -> labels.txt beside it.
+      std::string stem = fs::path(path).filename().string();
+      stem = stem.substr(0, stem.find('.'));
+      const std::string names = (fs::path(path).parent_path() / (stem + ".txt")).string();
+      if (!fs::exists(names))
+        Fail("label map '" + path + "': label '" + selector + "' is a name but there is no label file '" + names + "'");
+      const auto table = ReadLabelNames(names);
+      const auto it = table.find(selector);
+      if (it == table.end())
+        Fail("label file '" + names + "' has no label called '" + selector + "'");
+      value = it->second;
+    }
+    mask = ExtractLabel(labels, value, "label map '" + path + "'");
+  }
+  else
+  {
+    mask = ReadMask(path);
+  }
+  if (!SameGrid(mask, grid))
+  {
+    mask = ResampleMask(mask, grid);
+    if (CountInside(mask) == 0)
+      Fail("mask '" + source + "' does not overlap its image");
+  }
+  return mask;
+}
+
+void
+RegistrationProblem::LoadStructure(const std::string & name, bool fixedSide, const std::string & source)
+{
+  const ImageType * grid = fixedSide ? fixedImage.GetPointer() : movingImage.GetPointer();
+  if (grid == nullptr)
+    Fail("load the " + std::string(SideName(fixedSide)) + " image before its structures");
+  if (name.empty())
+    Fail("structure from '" + source + "' has no name");
+  Structure * s = FindStructure(name);
+  if (s == nullptr)
+  {
+    structures.push_back(Structure{});
+    s = &structures.back();
+    s->name = name;
+  }
+  MaskType::Pointer & mask = fixedSide ? s->fixedMask : s->movingMask;
+  PointListType &     points = fixedSide ? s->fixedPoints : s->movingPoints;
+  try
+  {
+    std::string path, selector;
+    SplitSource(source, path, selector);
+    if (selector.empty() && IsPointFile(path))
+    {
+      points = ReadLandmarks(path, grid);
+      return;
+    }
+    mask = LoadMask(source, grid, &points);
+  }
+  catch (const ExceptionObject & e)
+  {
+    Fail("structure '" + name + "' (" + SideName(fixedSide) + "): " + e.GetDescription());
+  }
+}
+
+void
+RegistrationProblem::LoadBodyMask(bool fixedSide, const std::string & source)
+{
+  const ImageType * grid = fixedSide ? fixedImage.GetPointer() : movingImage.GetPointer();
+  if (grid == nullptr)
+    Fail("load the images before the body masks");
+  (fixedSide ? fixedBodyMask : movingBodyMask) = LoadMask(source, grid, nullptr);
+}
+
+void
+RegistrationProblem::LoadLandmarks(const std::string & fixedPath, const std::string & movingPath)
+{
+  fixedLandmarks = ReadLandmarks(fixedPath, fixedImage);
+  movingLandmarks = ReadLandmarks(movingPath, movingImage);
+  if (fixedLandmarks.size() != movingLandmarks.size())
+    Fail("landmark files '" + fixedPath + "' and '" + movingPath + "' hold " + std::to_string(fixedLandmarks.size()) +
+         " and " + std::to_string(movingLandmarks.size()) + " points; they must pair up");
+}
+
+Structure *
+RegistrationProblem::FindStructure(const std::string & name)
+{
+  for (auto & s : structures)
+    if (s.name == name)
+      return &s;
+  return nullptr;
+}
+
+const Structure *
+RegistrationProblem::FindStructure(const std::string & name) const
+{
+  return const_cast<RegistrationProblem *>(this)->FindStructure(name);
+}
+
+const Structure &
+RegistrationProblem::GetStructure(const std::string & name) const
+{
+  if (const Structure * s = FindStructure(name))
+    return *s;
+  std::string known;
+  for (const auto & s : structures)
+    known += (known.empty() ? "" : ", ") + s.name;
+  Fail("no structure called '" + name + "' (known: " + (known.empty() ? "none" : known) + ")");
+}
+
+void
+RegistrationProblem::Validate() const
+{
+  if (fixedImage.IsNull() || movingImage.IsNull())
+    Fail("both a fixed and a moving image are needed");
+  for (const auto & s : structures)
+  {
+    for (bool fixedSide : { true, false })
+    {
+      const MaskType *      mask = fixedSide ? s.fixedMask.GetPointer() : s.movingMask.GetPointer();
+      const PointListType & points = fixedSide ? s.fixedPoints : s.movingPoints;
+      const ImageType *     grid = fixedSide ? fixedImage.GetPointer() : movingImage.GetPointer();
+      if (mask == nullptr && points.empty())
+        Fail("structure '" + s.name + "' is missing on the " + SideName(fixedSide) + " image");
+      if (mask != nullptr && !SameGrid(mask, grid))
+        Fail("structure '" + s.name + "': the " + std::string(SideName(fixedSide)) + " mask is not on the image grid");
+      if (mask != nullptr && CountInside(mask) == 0)
+        Fail("structure '" + s.name + "' is empty on the " + SideName(fixedSide) + " image");
+    }
+  }
+  for (bool fixedSide : { true, false })
+  {
+    const MaskType * body = fixedSide ? fixedBodyMask.GetPointer() : movingBodyMask.GetPointer();
+    if (body != nullptr && !SameGrid(body, fixedSide ? fixedImage.GetPointer() : movingImage.GetPointer()))
+      Fail(std::string("the ") + SideName(fixedSide) + " body mask is not on the image grid");
+  }
+  if (fixedLandmarks.size() != movingLandmarks.size())
+    Fail("fixed and moving landmark lists differ in length");
+  // The images must share some physical space, or no registration can relate them.
+  const auto bounds = [](const ImageType * image, PointType & lo, PointType & hi) {
+    const auto region = image->GetLargestPossibleRegion();
+    for (unsigned d = 0; d < Dimension; ++d)
+    {
+      lo[d] = std::numeric_limits<double>::max();
+      hi[d] = std::numeric_limits<double>::lowest();
+    }
+    for (unsigned corner = 0; corner < 8; ++corner)
+    {
+      ContinuousIndex<double, Dimension> index;
+      for (unsigned d = 0; d < Dimension; ++d)
+        index[d] = (corner >> d & 1) ? region.GetSize()[d] - 0.5 : -0.5;
+      PointType p;
+      image->TransformContinuousIndexToPhysicalPoint(index, p);
+      for (unsigned d = 0; d < Dimension; ++d)
+      {
+        lo[d] = std::min(lo[d], p[d]);
+        hi[d] = std::max(hi[d], p[d]);
+      }
+    }
+  };
+  PointType flo, fhi, mlo, mhi;
+  bounds(fixedImage, flo, fhi);
+  bounds(movingImage, mlo, mhi);
+  for (unsigned d = 0; d < Dimension; ++d)
+    if (fhi[d] <= mlo[d] || mhi[d] <= flo[d])
+      Fail("the fixed and moving images do not overlap in physical space");
+}
+
+} // namespace morea
+} // namespace itk

@@ -1,1 +1,194 @@
-// (being written)
+#include "itkRigidPreAlignment.h"
+
+#include "itkImageRegionConstIteratorWithIndex.h"
+#include "itkImageRegionIterator.h"
+#include "itkImageRegistrationMethodv4.h"
+#include "itkMeanSquaresImageToImageMetricv4.h"
+#include "itkPreprocessing.h"
+#include "itkRegistrationParameterScalesFromPhysicalShift.h"
+#include "itkRegularStepGradientDescentOptimizerv4.h"
+#include "itkSignedMaurerDistanceMapImageFilter.h"
+#include "itkMOREAImageIO.h"
+#include "itkTransformFileWriter.h"
+
+#include <chrono>
+#include <cstdio>
+#include <cmath>
+
+namespace itk
+{
+namespace morea
+{
+namespace
+{
+[[noreturn]] void
+Fail(const std::string & message)
+{
+  itkGenericExceptionMacro(<< message);
+}
+
+PointType
+Centroid(const MaskType * mask)
+{
+  double                                      sum[3] = { 0, 0, 0 };
+  std::size_t                                 n = 0;
+  ImageRegionConstIteratorWithIndex<MaskType> it(mask, mask->GetBufferedRegion());
+  for (; !it.IsAtEnd(); ++it)
+  {
+    if (it.Get() == 0)
+      continue;
+    PointType p;
+    mask->TransformIndexToPhysicalPoint(it.GetIndex(), p);
+    for (unsigned d = 0; d < Dimension; ++d)
+      sum[d] += p[d];
+    ++n;
+  }
+  if (n == 0)
+    Fail("rigid pre-alignment: a structure mask is empty");
+  PointType c;
+  for (unsigned d = 0; d < Dimension; ++d)
+    c[d] = sum[d] / static_cast<double>(n);
+  return c;
+}
+
+/** The mask's clipped signed distance map on a coarse isotropic grid around it. */
+ImageType::Pointer
+CoarseDistanceMap(const MaskType * mask, const RigidAlignmentOptions & options)
+{
+  PointType lower, upper;
+  MaskBoundingBox(mask, lower, upper);
+  const double           pad = options.distanceClip + 2.0 * options.workingSpacing;
+  auto                   grid = ImageType::New();
+  ImageType::SizeType    size;
+  ImageType::SpacingType spacing;
+  ImageType::PointType   origin;
+  for (unsigned d = 0; d < Dimension; ++d)
+  {
+    spacing[d] = options.workingSpacing;
+    origin[d] = lower[d] - pad;
+    size[d] = static_cast<SizeValueType>(std::ceil((upper[d] - lower[d] + 2.0 * pad) / spacing[d]));
+  }
+  grid->SetSpacing(spacing);
+  grid->SetOrigin(origin);
+  grid->SetRegions(ImageType::RegionType(size));
+  auto coarse = ResampleMask(mask, grid);
+
+  auto distance = SignedMaurerDistanceMapImageFilter<MaskType, ImageType>::New();
+  distance->SetInput(coarse);
+  distance->SetInsideIsPositive(false);
+  distance->SetSquaredDistance(false);
+  distance->SetUseImageSpacing(true);
+  distance->Update();
+  ImageType::Pointer map = distance->GetOutput();
+  const float        clip = static_cast<float>(options.distanceClip);
+  for (ImageRegionIterator<ImageType> it(map, map->GetBufferedRegion()); !it.IsAtEnd(); ++it)
+    it.Set(std::clamp(it.Get(), -clip, clip));
+  return map;
+}
+} // namespace
+
+RigidTransformType::Pointer
+AlignRigidly(const MaskType * fixedMask, const MaskType * movingMask, const RigidAlignmentOptions & options,
+             RigidAlignmentResult * result)
+{
+  const auto start = std::chrono::steady_clock::now();
+  if (fixedMask == nullptr || movingMask == nullptr)
+    Fail("rigid pre-alignment needs a fixed and a moving mask");
+
+  auto fixedMap = CoarseDistanceMap(fixedMask, options);
+  auto movingMap = CoarseDistanceMap(movingMask, options);
+
+  // Start from the centroids: removes the bulk of a table shift at once.
+  auto       transform = RigidTransformType::New();
+  const auto fixedCentre = Centroid(fixedMask);
+  const auto movingCentre = Centroid(movingMask);
+  transform->SetCenter(fixedCentre);
+  RigidTransformType::OutputVectorType translation;
+  for (unsigned d = 0; d < Dimension; ++d)
+    translation[d] = movingCentre[d] - fixedCentre[d];
+  transform->SetTranslation(translation);
+
+  using MetricType = MeanSquaresImageToImageMetricv4<ImageType, ImageType>;
+  using OptimizerType = RegularStepGradientDescentOptimizerv4<double>;
+  using RegistrationType = ImageRegistrationMethodv4<ImageType, ImageType, RigidTransformType>;
+  auto metric = MetricType::New();
+  auto optimizer = OptimizerType::New();
+  auto registration = RegistrationType::New();
+  auto scales = RegistrationParameterScalesFromPhysicalShift<MetricType>::New();
+  scales->SetMetric(metric);
+  optimizer->SetScalesEstimator(scales);
+  optimizer->SetLearningRate(options.workingSpacing);
+  optimizer->SetMinimumStepLength(1e-3);
+  optimizer->SetRelaxationFactor(0.6);
+  optimizer->SetNumberOfIterations(options.iterationsPerLevel);
+  optimizer->SetGradientMagnitudeTolerance(1e-6);
+  optimizer->SetDoEstimateLearningRateOnce(false);
+
+  registration->SetFixedImage(fixedMap);
+  registration->SetMovingImage(movingMap);
+  registration->SetMetric(metric);
+  registration->SetOptimizer(optimizer);
+  registration->SetInitialTransform(transform);
+  registration->InPlaceOn();
+  RegistrationType::ShrinkFactorsArrayType shrink(2);
+  shrink[0] = 2;
+  shrink[1] = 1;
+  RegistrationType::SmoothingSigmasArrayType sigmas(2);
+  sigmas[0] = 1.0;
+  sigmas[1] = 0.0;
+  registration->SetNumberOfLevels(2);
+  registration->SetShrinkFactorsPerLevel(shrink);
+  registration->SetSmoothingSigmasPerLevel(sigmas);
+  registration->SetMetricSamplingStrategy(RegistrationType::MetricSamplingStrategyType::NONE);
+
+  double initialMetric = 0.0;
+  {
+    metric->SetFixedImage(fixedMap);
+    metric->SetMovingImage(movingMap);
+    metric->SetMovingTransform(transform);
+    metric->Initialize();
+    initialMetric = metric->GetValue();
+  }
+  try
+  {
+    registration->Update();
+  }
+  catch (const ExceptionObject & e)
+  {
+    Fail(std::string("rigid pre-alignment failed: ") + e.GetDescription());
+  }
+
+  if (result != nullptr)
+  {
+    result->initialMetric = initialMetric;
+    result->finalMetric = optimizer->GetCurrentMetricValue();
+    result->iterations = static_cast<unsigned>(optimizer->GetCurrentIteration());
+    for (unsigned d = 0; d < Dimension; ++d)
+      result->translation[d] = transform->GetTranslation()[d];
+    result->rotationDegrees = transform->GetVersor().GetAngle() * 180.0 / M_PI;
+    result->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+  return transform;
+}
+
+void
+WriteRigidTransform(const RigidTransformType * transform, const std::string & path)
+{
+  const std::string tmp = TemporaryPathFor(path);
+  auto              writer = TransformFileWriterTemplate<double>::New();
+  writer->SetInput(transform);
+  writer->SetFileName(tmp);
+  try
+  {
+    writer->Update();
+  }
+  catch (const ExceptionObject & e)
+  {
+    std::remove(tmp.c_str());
+    Fail("cannot write transform '" + path + "': " + e.GetDescription());
+  }
+  CommitFile(tmp, path);
+}
+
+} // namespace morea
+} // namespace itk

@@ -1,0 +1,90 @@
+// Shared pieces of the `morea` subcommands: loading a problem from options or
+// a problem folder, parameters, and plain-text output helpers.
+#ifndef morea_cli_CommandCommon_h
+#define morea_cli_CommandCommon_h
+
+#include "itkRegistrationEvaluation.h"
+#include "itkRegistrationProblem.h"
+#include "morea/ParameterSet.h"
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace morea::cli
+{
+/** Options that describe a registration problem on the command line. */
+struct ProblemOptions
+{
+  std::string              folder; ///< a problem folder (layout written by `phantom` and `preprocess`)
+  std::string              fixed;
+  std::string              moving;
+  std::vector<std::string> fixedStructures;  ///< NAME=SOURCE
+  std::vector<std::string> movingStructures; ///< NAME=SOURCE
+  std::string              fixedBody;
+  std::string              movingBody;
+  std::string              fixedLandmarks;
+  std::string              movingLandmarks;
+
+  void
+  AddTo(CLI::App & app);
+  /** Loads and validates the problem (folder first, then explicit options on top). */
+  itk::morea::RegistrationProblem
+  Load() const;
+};
+
+/** --parameters FILE, --var NAME=VALUE, --set KEY=VALUE. */
+struct ParameterOptions
+{
+  std::string              file;
+  std::vector<std::string> variables;
+  std::vector<std::string> overrides;
+
+  void
+  AddTo(CLI::App & app);
+  ParameterSet
+  Load() const;
+};
+
+/** Writes a problem in the folder layout that ProblemOptions::folder reads:
+ *  fixed.nii.gz, moving.nii.gz, fixed_masks/NAME.nii.gz, moving_masks/NAME.nii.gz,
+ *  fixed_points/NAME.csv, moving_points/NAME.csv, fixed_body.nii.gz,
+ *  moving_body.nii.gz, fixed_landmarks.txt, moving_landmarks.txt. */
+void
+WriteProblemFolder(const itk::morea::RegistrationProblem & problem, const std::string & folder);
+
+/** Splits "NAME=VALUE"; throws naming `what` when there is no '='. */
+std::pair<std::string, std::string>
+SplitAssignment(const std::string & text, const std::string & what);
+
+void
+WriteJson(const nlohmann::json & json, const std::string & path);
+
+nlohmann::json
+ToJson(const itk::morea::EvaluationScores & scores);
+/** A plain-text table of the scores. */
+void
+PrintScores(std::ostream & out, const itk::morea::EvaluationScores & scores, const std::string & title);
+
+/** Renders PREFIX_{axial,coronal,sagittal}.png: fixed contours (green) and moving
+ *  contours warped by `field` (magenta; identity when null) on the fixed image. */
+void
+RenderComparison(const itk::morea::RegistrationProblem & problem, const itk::morea::DisplacementFieldType * field,
+                 const std::string & focusStructure, const std::string & prefix);
+
+void
+AddPhantomCommand(CLI::App & app);
+void
+AddPreprocessCommand(CLI::App & app);
+void
+AddEvaluateCommand(CLI::App & app);
+void
+AddDemoCommand(CLI::App & app);
+void
+AddInfoCommand(CLI::App & app);
+} // namespace morea::cli
+
+#endif

@@ -1,0 +1,126 @@
+// `morea demo`: the default job on the embedded phantom. Generates the phantom,
+// preprocesses it, and scores the rigid baseline and the known true
+// deformation with the evaluation pipeline.
+#include "CommandCommon.h"
+
+#include "itkImageRegionIteratorWithIndex.h"
+#include "itkMOREAImageIO.h"
+#include "itkPhantomImages.h"
+#include "itkPreprocessing.h"
+#include "morea/ComputeDevices.h"
+
+#include <chrono>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+
+namespace morea::cli
+{
+namespace
+{
+/** The phantom's true mapping expressed on a preprocessed grid: the fixed frame
+ *  is unchanged, the preprocessed moving image is the original one seen through
+ *  the rigid map R, so u(x) = R^-1(T(x)) - x and v(y) = T^-1(R(y)) - y. */
+itk::morea::DisplacementFieldType::Pointer
+TrueField(const PelvisPhantom & phantom, const itk::morea::RegistrationProblem & problem,
+          const itk::morea::RigidTransformType * rigid, bool fixedToMoving)
+{
+  using namespace itk::morea;
+  auto       field = MakeIdentityField(problem.fixedImage);
+  const auto rigidInverse = rigid->GetInverseTransform();
+  for (itk::ImageRegionIteratorWithIndex<DisplacementFieldType> it(field, field->GetBufferedRegion()); !it.IsAtEnd();
+       ++it)
+  {
+    PointType x;
+    field->TransformIndexToPhysicalPoint(it.GetIndex(), x);
+    PointType y;
+    if (fixedToMoving)
+    {
+      const Vec3 t = phantom.FixedToMoving({ x[0], x[1], x[2] });
+      y = rigidInverse->TransformPoint(PointType(t.data()));
+    }
+    else
+    {
+      const PointType r = rigid->TransformPoint(x);
+      const Vec3      t = phantom.MovingToFixed({ r[0], r[1], r[2] });
+      y = PointType(t.data());
+    }
+    it.Set(y - x);
+  }
+  return field;
+}
+} // namespace
+
+void
+AddDemoCommand(CLI::App & app)
+{
+  struct Options
+  {
+    std::string      output{ "demo-out" };
+    double           spacing{ 2.0 };
+    ParameterOptions parameters;
+  };
+  auto   options = std::make_shared<Options>();
+  auto * cmd = app.add_subcommand("demo", "run the default job on the embedded phantom and print its scores");
+  cmd->add_option("-o,--output", options->output, "output folder")->capture_default_str();
+  cmd->add_option("--phantom-spacing", options->spacing, "voxel size of the generated phantom in mm")
+    ->capture_default_str();
+  options->parameters.AddTo(*cmd);
+  cmd->callback([options] {
+    using namespace itk::morea;
+    namespace fs = std::filesystem;
+    const auto start = std::chrono::steady_clock::now();
+    const auto parameters = options->parameters.Load();
+
+    PhantomOptions phantomOptions;
+    phantomOptions.spacing = options->spacing;
+    const PelvisPhantom phantom(phantomOptions);
+    const fs::path      root(options->output);
+    WritePhantomCase(phantom.Generate(), (root / "phantom").string());
+    std::cout << "1. phantom written to " << (root / "phantom").string() << "\n";
+
+    ProblemOptions load;
+    load.folder = (root / "phantom").string();
+    const auto input = load.Load();
+    const auto result = Preprocess(input, PreprocessOptions::FromParameters(parameters));
+    WriteProblemFolder(result.problem, (root / "preprocessed").string());
+    WriteRigidTransform(result.rigidTransform, (root / "preprocessed" / "rigid_fixed_to_moving.tfm").string());
+    const auto & r = result.report;
+    std::cout << "2. preprocessed: " << r.size[0] << "x" << r.size[1] << "x" << r.size[2] << " voxels of " << r.spacing
+              << " mm around '" << r.cropStructure << "', rigid on '" << r.rigidStructure << "'\n";
+
+    const double margin = parameters.GetReal("evaluation_border_margin");
+    const auto   baseline = EvaluateRegistration(result.problem, nullptr, nullptr, margin);
+    const auto   forward = TrueField(phantom, result.problem, result.rigidTransform, true);
+    const auto   inverse = TrueField(phantom, result.problem, result.rigidTransform, false);
+    const auto   truth = EvaluateRegistration(result.problem, forward, inverse, margin);
+    WriteDisplacementField(forward, (root / "preprocessed_true_fixed_to_moving.nii.gz").string());
+    WriteDisplacementField(inverse, (root / "preprocessed_true_moving_to_fixed.nii.gz").string());
+    std::cout << "3. evaluation\n";
+    PrintScores(std::cout, baseline, "   baseline after rigid pre-alignment");
+    PrintScores(std::cout, truth, "   true deformation (upper bound of what a registration can reach)");
+    RenderComparison(result.problem, nullptr, r.cropStructure, (root / "render_baseline").string());
+    RenderComparison(result.problem, forward, r.cropStructure, (root / "render_truth").string());
+    WriteJson({ { "baseline", ToJson(baseline) }, { "truth", ToJson(truth) } }, (root / "scores.json").string());
+    std::cout << "4. scores.json and render_*.png written to " << root.string() << " ("
+              << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() << " s)\n";
+  });
+}
+
+void
+AddInfoCommand(CLI::App & app)
+{
+  auto * cmd = app.add_subcommand("info", "print the build's capabilities and the CUDA devices found");
+  cmd->callback([] {
+    std::cout << "morea 0.1.0\n";
+    std::cout << "CUDA backend in this build: " << (BuiltWithCuda() ? "yes" : "no") << "\n";
+    const auto devices = ListCudaDevices();
+    if (devices.empty())
+      std::cout << "CUDA devices: none (" << CudaUnavailableReason() << ")\n";
+    for (const auto & d : devices)
+      std::cout << "CUDA device " << d.ordinal << ": " << d.name << ", compute " << d.computeCapabilityMajor << "."
+                << d.computeCapabilityMinor << ", " << d.totalMemoryBytes / (1024 * 1024) << " MiB, "
+                << d.multiprocessors << " SMs\n";
+  });
+}
+} // namespace morea::cli
