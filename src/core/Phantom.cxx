@@ -280,7 +280,11 @@ PelvisPhantom::HounsfieldAt(const Vec3 & x) const
   if (!InBody(x))
     return -1000.0; // air
   if (InBones(x))
-    return 700.0;
+  {
+    // Trabecular texture, fixed to the bone: gives intensity-based alignment
+    // something to hold on to inside the bone, as real marrow does.
+    return 550.0 + 250.0 * std::sin(x[0] / 1.7) * std::sin(x[1] / 1.3 + 0.5) * std::sin(x[2] / 1.9 + 1.0);
+  }
   if (InBladder(x))
     return 5.0; // urine: low contrast to the surrounding tissue, as in CT
   if (InRectum(x))

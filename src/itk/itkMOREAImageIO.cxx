@@ -57,6 +57,13 @@ ReadFile(const std::string & path, const std::string & what)
     // ITK pads 2D files to 3D silently; a 2D structure on a 3D problem is an input error.
     Fail(what + " '" + path + "' has " + std::to_string(io->GetNumberOfDimensions()) + " dimensions, expected 3");
   }
+  const unsigned int components = PixelTraits<typename TImage::PixelType>::Dimension;
+  if (io != nullptr && io->GetNumberOfComponents() != components)
+  {
+    // ITK converts silently (RGB to luminance, a scalar copied into every vector component).
+    Fail(what + " '" + path + "' has " + std::to_string(io->GetNumberOfComponents()) +
+         " components per voxel, expected " + std::to_string(components));
+  }
   typename TImage::Pointer image = reader->GetOutput();
   image->DisconnectPipeline();
   return image;
@@ -314,7 +321,8 @@ template <typename TImage>
 void
 WriteFileAtomically(const TImage * image, const std::string & path)
 {
-  const fs::path parent = fs::path(path).parent_path();
+  const fs::path target(path);
+  const fs::path parent = target.parent_path();
   if (!parent.empty())
   {
     std::error_code ec;
@@ -324,23 +332,46 @@ WriteFileAtomically(const TImage * image, const std::string & path)
       Fail("cannot create folder '" + parent.string() + "': " + ec.message());
     }
   }
-  const std::string tmp = TemporaryPathFor(path);
-  auto              writer = ImageFileWriter<TImage>::New();
+  // Write under the final file name inside a temporary folder next to the
+  // target, then move the file(s) into place. Formats with separate header and
+  // data files (.mhd + .zraw, .hdr + .img, .nhdr + .raw) name the data file
+  // after the header, so writing under a temporary name and renaming only the
+  // header would break the pair. The requested file is moved last.
+  const fs::path  folder = TemporaryPathFor(path) + ".d";
+  std::error_code ec;
+  if (!fs::create_directory(folder, ec) || ec)
+  {
+    Fail("cannot write '" + path + "': cannot create temporary folder '" + folder.string() + "'");
+  }
+  const fs::path staged = folder / target.filename();
+  auto           writer = ImageFileWriter<TImage>::New();
   writer->SetInput(image);
-  writer->SetFileName(tmp);
+  writer->SetFileName(staged.string());
   writer->SetUseCompression(true);
   try
   {
     writer->Update();
+    if (!fs::exists(staged))
+    {
+      Fail("the writer produced no file");
+    }
+    for (const auto & entry : fs::directory_iterator(folder))
+    {
+      if (entry.path() != staged)
+      {
+        CommitFile(entry.path().string(), (parent / entry.path().filename()).string());
+      }
+    }
+    CommitFile(staged.string(), path);
   }
   catch (const ExceptionObject & e)
   {
-    std::error_code ec;
-    fs::remove(tmp, ec);
+    fs::remove_all(folder, ec);
     Fail("cannot write '" + path + "': " + e.GetDescription());
   }
-  CommitFile(tmp, path);
+  fs::remove_all(folder, ec);
 }
+
 } // namespace
 
 void

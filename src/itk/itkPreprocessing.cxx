@@ -350,7 +350,10 @@ Preprocess(const RegistrationProblem & input, const PreprocessOptions & options)
     const Structure & s = input.GetStructure(options.rigidStructure);
     if (s.fixedMask.IsNull() || s.movingMask.IsNull())
       Fail("rigid pre-alignment structure '" + s.name + "' needs masks on both images");
-    rigid = AlignRigidly(s.fixedMask, s.movingMask, RigidAlignmentOptions{}, &report.rigid);
+    RigidAlignmentOptions rigidOptions;
+    rigidOptions.intensityClampMin = std::max(options.windowMin, options.fieldOfViewThreshold);
+    rigidOptions.intensityClampMax = options.windowMax;
+    rigid = AlignRigidly(s.fixedMask, s.movingMask, rigidOptions, &report.rigid, input.fixedImage, input.movingImage);
     report.rigidStructure = s.name;
   }
   result.rigidTransform = rigid;
