@@ -1,0 +1,222 @@
+# End-to-end test of the `morea` command line on the synthetic phantom:
+#   phantom -> preprocess -> evaluate (identity baseline, with renders),
+#   evaluate with the phantom's true fields, a TOML parameter file with a
+#   $placeholder, and `morea info`.
+#
+# Run as: cmake -DMOREA=<morea executable> -DWORK=<scratch folder> -DSOURCE=<repo root> -P EndToEnd.cmake
+cmake_minimum_required(VERSION 3.19) # string(JSON ...)
+
+foreach(var MOREA WORK)
+  if(NOT DEFINED ${var} OR "${${var}}" STREQUAL "")
+    message(FATAL_ERROR "EndToEnd.cmake: pass -D${var}=...")
+  endif()
+endforeach()
+if(NOT EXISTS "${MOREA}")
+  message(FATAL_ERROR "EndToEnd.cmake: the morea executable '${MOREA}' does not exist")
+endif()
+
+file(REMOVE_RECURSE "${WORK}")
+file(MAKE_DIRECTORY "${WORK}")
+
+# morea_ok(<label> ARGS...): runs morea with ARGS, fails the test unless it exits 0;
+# leaves its stdout and stderr in MOREA_STDOUT and MOREA_STDERR.
+function(morea_ok label)
+  string(TIMESTAMP start "%s")
+  execute_process(
+    COMMAND "${MOREA}" ${ARGN}
+    RESULT_VARIABLE rc
+    OUTPUT_VARIABLE out
+    ERROR_VARIABLE err)
+  string(TIMESTAMP stop "%s")
+  math(EXPR seconds "${stop} - ${start}")
+  if(NOT rc STREQUAL "0")
+    string(REPLACE ";" " " cmdline "${ARGN}")
+    message(FATAL_ERROR "${label}: `morea ${cmdline}` exited with '${rc}'\n--- stdout:\n${out}\n--- stderr:\n${err}")
+  endif()
+  message(STATUS "${label}: ok (${seconds} s)")
+  set(MOREA_STDOUT "${out}" PARENT_SCOPE)
+  set(MOREA_STDERR "${err}" PARENT_SCOPE)
+endfunction()
+
+function(expect_files label)
+  foreach(f IN LISTS ARGN)
+    if(NOT EXISTS "${f}")
+      message(FATAL_ERROR "${label}: expected output '${f}' is missing")
+    endif()
+    if(NOT IS_DIRECTORY "${f}")
+      file(SIZE "${f}" size)
+      if(size EQUAL 0)
+        message(FATAL_ERROR "${label}: output '${f}' is empty")
+      endif()
+    endif()
+  endforeach()
+endfunction()
+
+# json_number(<out var> <label> <json text> <member path...>): a numeric member, or a test failure.
+function(json_number outvar label json)
+  string(JSON value ERROR_VARIABLE jerr GET "${json}" ${ARGN})
+  if(jerr)
+    string(REPLACE ";" "." where "${ARGN}")
+    message(FATAL_ERROR "${label}: no '${where}' in the JSON: ${jerr}\n${json}")
+  endif()
+  if(NOT value MATCHES "^-?[0-9]+(\\.[0-9]*)?([eE][-+]?[0-9]+)?$")
+    string(REPLACE ";" "." where "${ARGN}")
+    message(FATAL_ERROR "${label}: '${where}' is '${value}', not a number")
+  endif()
+  set(${outvar} "${value}" PARENT_SCOPE)
+endfunction()
+
+# --- info -------------------------------------------------------------------------------------------
+morea_ok("info" info)
+if(NOT MOREA_STDOUT MATCHES "morea [0-9]")
+  message(FATAL_ERROR "info: stdout does not name the version:\n${MOREA_STDOUT}")
+endif()
+
+# --- phantom ----------------------------------------------------------------------------------------
+set(phantom "${WORK}/phantom")
+morea_ok("phantom" phantom -o "${phantom}" --spacing 4)
+expect_files("phantom"
+  "${phantom}/fixed.nii.gz"
+  "${phantom}/moving.nii.gz"
+  "${phantom}/fixed_masks/bladder.nii.gz"
+  "${phantom}/moving_masks/bladder.nii.gz"
+  "${phantom}/fixed_landmarks.txt"
+  "${phantom}/moving_landmarks.txt"
+  "${phantom}/true_fixed_to_moving.nii.gz"
+  "${phantom}/true_moving_to_fixed.nii.gz"
+  "${phantom}/phantom.json")
+file(READ "${phantom}/phantom.json" phantom_json)
+json_number(phantom_spacing "phantom.json" "${phantom_json}" spacing_mm)
+if(NOT phantom_spacing EQUAL 4)
+  message(FATAL_ERROR "phantom.json: spacing_mm is ${phantom_spacing}, expected 4")
+endif()
+file(GLOB leftovers "${phantom}/.*" "${phantom}/*/.*")
+if(leftovers)
+  message(FATAL_ERROR "phantom: temporary files were left behind: ${leftovers}")
+endif()
+
+# --- preprocess -------------------------------------------------------------------------------------
+set(pre "${WORK}/pre")
+morea_ok("preprocess" preprocess --problem "${phantom}" --set preprocess_isotropic_spacing=3 -o "${pre}")
+set(preprocess_stdout "${MOREA_STDOUT}")
+if(NOT preprocess_stdout MATCHES "bladder")
+  message(FATAL_ERROR "preprocess: stdout does not mention 'bladder':\n${preprocess_stdout}")
+endif()
+expect_files("preprocess"
+  "${pre}/fixed.nii.gz"
+  "${pre}/moving.nii.gz"
+  "${pre}/fixed_masks"
+  "${pre}/fixed_masks/bladder.nii.gz"
+  "${pre}/moving_masks/bladder.nii.gz"
+  "${pre}/fixed_points/bladder.csv"
+  "${pre}/moving_points/bladder.csv"
+  "${pre}/preprocess.json"
+  "${pre}/rigid_fixed_to_moving.tfm")
+file(READ "${pre}/preprocess.json" pre_json)
+json_number(pre_spacing "preprocess.json" "${pre_json}" spacing_mm)
+if(NOT pre_spacing EQUAL 3)
+  message(FATAL_ERROR "preprocess.json: spacing_mm is ${pre_spacing}, expected 3 (from --set)")
+endif()
+string(JSON pre_crop GET "${pre_json}" crop_structure)
+if(NOT pre_crop STREQUAL "bladder")
+  message(FATAL_ERROR "preprocess.json: crop_structure is '${pre_crop}', expected 'bladder' (the deforming organ)")
+endif()
+set(pre_size)
+foreach(i 0 1 2)
+  json_number(n "preprocess.json" "${pre_json}" size ${i})
+  list(APPEND pre_size ${n})
+endforeach()
+file(GLOB leftovers "${pre}/.*" "${pre}/*/.*")
+if(leftovers)
+  message(FATAL_ERROR "preprocess: temporary files were left behind: ${leftovers}")
+endif()
+
+# --- evaluate the identity baseline on the preprocessed problem -------------------------------------
+morea_ok("evaluate baseline" evaluate --problem "${pre}" -o "${WORK}/scores.json" --render "${WORK}/render")
+expect_files("evaluate baseline"
+  "${WORK}/scores.json"
+  "${WORK}/render_axial.png"
+  "${WORK}/render_coronal.png"
+  "${WORK}/render_sagittal.png")
+if(NOT MOREA_STDOUT MATCHES "bladder")
+  message(FATAL_ERROR "evaluate baseline: the printed table does not list 'bladder':\n${MOREA_STDOUT}")
+endif()
+file(READ "${WORK}/scores.json" scores)
+if(NOT scores MATCHES "\"dice\"")
+  message(FATAL_ERROR "scores.json has no \"dice\":\n${scores}")
+endif()
+json_number(baseline_dice "scores.json" "${scores}" structures bladder dice)
+if(NOT baseline_dice LESS 0.6 OR baseline_dice LESS 0)
+  message(FATAL_ERROR "scores.json: the baseline bladder Dice is ${baseline_dice}; the bladder fills a lot "
+                      "between the phantom's images, so the identity should score < 0.6")
+endif()
+message(STATUS "baseline bladder Dice ${baseline_dice}")
+file(READ "${WORK}/render_axial.png" png_magic LIMIT 8 HEX)
+if(NOT png_magic STREQUAL "89504e470d0a1a0a")
+  message(FATAL_ERROR "render_axial.png is not a PNG (starts with ${png_magic})")
+endif()
+
+# --- evaluate the true deformation on the original phantom ------------------------------------------
+morea_ok("evaluate truth" evaluate --problem "${phantom}"
+  --field "${phantom}/true_fixed_to_moving.nii.gz"
+  --inverse-field "${phantom}/true_moving_to_fixed.nii.gz"
+  --border-margin 0 -o "${WORK}/truth.json")
+file(READ "${WORK}/truth.json" truth)
+json_number(truth_dice "truth.json" "${truth}" structures bladder dice)
+json_number(truth_tre "truth.json" "${truth}" landmarks tre_mean_mm)
+json_number(truth_count "truth.json" "${truth}" landmarks count)
+json_number(truth_ic "truth.json" "${truth}" inverse_consistency mean_mm)
+json_number(truth_margin "truth.json" "${truth}" border_margin_mm)
+message(STATUS "true field: bladder Dice ${truth_dice}, TRE mean ${truth_tre} mm over ${truth_count} landmarks, "
+               "inverse consistency mean ${truth_ic} mm")
+if(NOT truth_dice GREATER 0.9 OR truth_dice GREATER 1)
+  message(FATAL_ERROR "truth.json: the true field's bladder Dice is ${truth_dice}, expected > 0.9")
+endif()
+if(NOT truth_count GREATER 0)
+  message(FATAL_ERROR "truth.json: no landmarks were scored")
+endif()
+if(NOT truth_tre LESS 0.5)
+  message(FATAL_ERROR "truth.json: the true field's landmark TRE mean is ${truth_tre} mm, expected < 0.5 mm")
+endif()
+if(NOT truth_ic LESS 0.5)
+  message(FATAL_ERROR "truth.json: the true fields' inverse consistency mean is ${truth_ic} mm, expected < 0.5 mm")
+endif()
+if(NOT truth_margin EQUAL 0)
+  message(FATAL_ERROR "truth.json: border_margin_mm is ${truth_margin}, expected 0 (from --border-margin)")
+endif()
+
+# --- a TOML parameter file with a $placeholder filled by --var --------------------------------------
+# The margin shrinks from the default 30 mm to 20 mm, so the crop must not grow and must shrink somewhere.
+# A '$' in a comment and in a literal string is not a placeholder.
+file(WRITE "${WORK}/params.toml" [=[
+# Preprocessing for the CLI test; costs $nothing (a comment is not substituted).
+problem_id = 'phantom $literal'
+preprocess_isotropic_spacing = 3.0
+preprocess_crop_margin = $margin
+]=])
+set(pre_toml "${WORK}/pre-toml")
+morea_ok("preprocess with --parameters/--var" preprocess --problem "${phantom}"
+  --parameters "${WORK}/params.toml" --var margin=20 -o "${pre_toml}")
+expect_files("preprocess with --parameters/--var" "${pre_toml}/fixed.nii.gz" "${pre_toml}/preprocess.json")
+file(READ "${pre_toml}/preprocess.json" toml_json)
+json_number(toml_spacing "preprocess.json (TOML)" "${toml_json}" spacing_mm)
+if(NOT toml_spacing EQUAL 3)
+  message(FATAL_ERROR "preprocess.json (TOML): spacing_mm is ${toml_spacing}, expected 3 from the parameter file")
+endif()
+set(shrunk FALSE)
+foreach(i 0 1 2)
+  json_number(n "preprocess.json (TOML)" "${toml_json}" size ${i})
+  list(GET pre_size ${i} n30)
+  if(n GREATER n30)
+    message(FATAL_ERROR "preprocess with margin 20: size[${i}] is ${n}, larger than ${n30} with the default margin 30")
+  endif()
+  if(n LESS n30)
+    set(shrunk TRUE)
+  endif()
+endforeach()
+if(NOT shrunk)
+  message(FATAL_ERROR "preprocess with --var margin=20: the crop (${toml_json}) is no smaller than with the "
+                      "default 30 mm margin (${pre_size}); was the placeholder substituted?")
+endif()
+
+message(STATUS "cli.end_to_end: all checks passed")
