@@ -95,7 +95,7 @@ RegistrationProblem::LoadMask(const std::string & source, const ImageType * grid
   std::string path, selector;
   SplitSource(source, path, selector);
   MaskType::Pointer mask;
-  if (IsDicomFile(path) && !selector.empty())
+  if ((fs::is_directory(path) || IsDicomFile(path)) && !selector.empty())
   {
     const auto   rois = ReadRTStructureSet(path);
     const auto & roi = FindROI(rois, selector);
