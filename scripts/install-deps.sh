@@ -11,7 +11,7 @@ packages=(
   libcli11-dev             # command-line parsing
   nlohmann-json3-dev       # JSON outputs
   libgtest-dev libgmock-dev
-  libpng-dev
+  libpng-dev zlib1g-dev
   xz-utils                 # tests unpack the DICOM test archive
 )
 

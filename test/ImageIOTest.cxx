@@ -407,7 +407,7 @@ TEST(ImageIO, TruncatedFileIsAnError)
 }
 
 // Known defect: ITK 5.2's NIfTI reader (niftilib) reads a truncated .nii.gz without an error.
-TEST(ImageIO, DISABLED_TruncatedNiftiIsAnError)
+TEST(ImageIO, TruncatedNiftiIsAnError)
 {
   const auto dir = ScratchDir();
   auto       image = MakeImage();

@@ -8,6 +8,9 @@
 #include "itkImageRegionIterator.h"
 #include "itkImageSeriesReader.h"
 
+#include <zlib.h>
+
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <filesystem>
@@ -27,6 +30,106 @@ namespace
 Fail(const std::string & message)
 {
   itkGenericExceptionMacro(<< message);
+}
+
+void
+CheckNotTruncated(const std::string & path, long long available, long long needed, const std::string & what)
+{
+  if (available < needed)
+  {
+    Fail(what + " '" + path + "' is truncated: " +
+         (available < 0 ? std::string("its compressed data stream ends early")
+                        : std::to_string(available) + " of " + std::to_string(needed) + " bytes of voxel data present"));
+  }
+}
+
+std::string
+LowerCase(std::string s)
+{
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+  return s;
+}
+
+/** Bytes of voxel data a file holds after `offset`, following gzip streams to
+ *  their end; -1 when the gzip stream itself is cut short. */
+long long
+PayloadBytes(const std::string & path, long long offset, bool gzipped)
+{
+  if (!gzipped)
+    return static_cast<long long>(fs::file_size(path)) - offset;
+  gzFile file = gzopen(path.c_str(), "rb");
+  if (file == nullptr)
+    return -1;
+  std::vector<char> buffer(1 << 16);
+  long long         total = 0;
+  int               n = 0;
+  while ((n = gzread(file, buffer.data(), static_cast<unsigned>(buffer.size()))) > 0)
+    total += n;
+  int         error = Z_OK;
+  const char * message = gzerror(file, &error);
+  (void)message;
+  gzclose(file);
+  if (n < 0 || (error != Z_OK && error != Z_STREAM_END))
+    return -1;
+  return total - offset;
+}
+
+/** ITK 5.2's MetaImage and NIfTI readers accept files cut short (they warn or pad
+ *  with zeros); a truncated scan must be an error, so check the data size here. */
+void
+CheckNotTruncated(const std::string & path, const ImageIOBase * io, const std::string & what)
+{
+  const std::string name = LowerCase(fs::path(path).filename().string());
+  const auto        endsWith = [&name](const std::string & ext) {
+    return name.size() >= ext.size() && name.compare(name.size() - ext.size(), ext.size(), ext) == 0;
+  };
+  const long long needed = static_cast<long long>(io->GetImageSizeInBytes());
+  long long       available = needed;
+  if (endsWith(".nii") || endsWith(".nii.gz"))
+  {
+    // NIfTI-1: the voxel data start at vox_offset (a float at byte 108; 352 by default).
+    const bool    gz = endsWith(".gz");
+    long long     offset = 352;
+    std::ifstream in(path, std::ios::binary);
+    if (!gz && in)
+    {
+      float voxOffset = 0.0f;
+      in.seekg(108);
+      if (in.read(reinterpret_cast<char *>(&voxOffset), sizeof voxOffset) && voxOffset >= 348.0f)
+        offset = static_cast<long long>(voxOffset);
+    }
+    available = PayloadBytes(path, offset, gz);
+  }
+  else if (endsWith(".mha"))
+  {
+    std::ifstream in(path, std::ios::binary);
+    std::string   line;
+    long long     compressedSize = -1;
+    bool          compressed = false;
+    while (std::getline(in, line))
+    {
+      if (line.rfind("CompressedDataSize", 0) == 0)
+        compressedSize = std::atoll(line.substr(line.find('=') + 1).c_str());
+      if (line.rfind("CompressedData", 0) == 0 && line.find("True") != std::string::npos)
+        compressed = true;
+      if (line.rfind("ElementDataFile", 0) == 0)
+      {
+        if (line.find("LOCAL") == std::string::npos)
+          return; // data in another file: ITK checks that one
+        break;
+      }
+    }
+    const long long offset = static_cast<long long>(in.tellg());
+    const long long rest = static_cast<long long>(fs::file_size(path)) - offset;
+    if (compressed)
+    {
+      if (compressedSize > 0 && rest < compressedSize)
+        available = -1;
+      return CheckNotTruncated(path, available, needed, what);
+    }
+    available = rest;
+  }
+  CheckNotTruncated(path, available, needed, what);
 }
 
 template <typename TImage>
@@ -63,6 +166,10 @@ ReadFile(const std::string & path, const std::string & what)
     // ITK converts silently (RGB to luminance, a scalar copied into every vector component).
     Fail(what + " '" + path + "' has " + std::to_string(io->GetNumberOfComponents()) +
          " components per voxel, expected " + std::to_string(components));
+  }
+  if (io != nullptr)
+  {
+    CheckNotTruncated(path, io, what);
   }
   typename TImage::Pointer image = reader->GetOutput();
   image->DisconnectPipeline();

@@ -13,7 +13,7 @@ endforeach()
 if(NOT EXISTS "${MOREA}")
   message(FATAL_ERROR "BadInputs.cmake: the morea executable '${MOREA}' does not exist")
 endif()
-find_program(PYTHON3 NAMES python3 python)
+find_program(PYTHON3 NAMES python3)
 if(NOT PYTHON3)
   message(FATAL_ERROR "BadInputs.cmake: python3 is needed to write the binary test images")
 endif()
@@ -26,7 +26,7 @@ set(in "${WORK}/in")
 # A 20^3 grid of 2 mm voxels: a bright sphere (the structure "blob") on a dark background, shifted by
 # 2 mm on the moving image. Then the broken variants.
 file(WRITE "${WORK}/make_inputs.py" [=[
-import math, os, struct, sys
+import gzip, math, os, struct, sys
 
 out = sys.argv[1]
 N, SP = 20, 2.0
@@ -79,6 +79,21 @@ nan_image[N ** 3 // 2] = float("nan")
 write("nan.mha", header(grid[0], "MET_FLOAT", grid[1]) + floats(nan_image))
 # 4^3 floats need 256 bytes; give 100.
 write("truncated.mha", header((4, 4, 4), "MET_FLOAT", (1.0, 1.0, 1.0)) + bytes(range(100)))
+# A NIfTI-1 image whose gzip stream is cut off half-way (an interrupted copy).
+def nifti(dims, spacing, data):
+    h = bytearray(348)
+    struct.pack_into("<i", h, 0, 348)
+    struct.pack_into("<8h", h, 40, 3, dims[0], dims[1], dims[2], 1, 1, 1, 1)
+    struct.pack_into("<2h", h, 70, 16, 32)  # datatype FLOAT32, bitpix
+    struct.pack_into("<8f", h, 76, 1.0, spacing[0], spacing[1], spacing[2], 1.0, 1.0, 1.0, 1.0)
+    struct.pack_into("<2f", h, 108, 352.0, 1.0)  # vox_offset, scl_slope
+    h[123] = 2  # millimetres
+    struct.pack_into("<2h", h, 252, 0, 1)  # qform_code, sform_code
+    struct.pack_into("<12f", h, 280, spacing[0], 0, 0, 0, 0, spacing[1], 0, 0, 0, 0, spacing[2], 0)
+    h[344:348] = b"n+1\0"
+    return bytes(h) + bytes(4) + data
+compressed = gzip.compress(nifti(grid[0], grid[1], floats(moving)))
+write("truncated.nii.gz", compressed[: len(compressed) // 2])
 # A zero spacing, with a complete data file beside the header.
 write("zero_spacing.mhd", header((4, 4, 4), "MET_FLOAT", (0.0, 1.0, 1.0), datafile="zero_spacing.raw"))
 write("zero_spacing.raw", floats([1.0] * 64))
@@ -106,6 +121,13 @@ set(blob --fixed-structure "blob=${in}/blob_fixed.mha" --moving-structure "blob=
 # --- helpers ----------------------------------------------------------------------------------------
 set(checked 0)
 
+# A failed case is recorded and the next case runs; the test fails at the end, listing them all.
+macro(case_failed text)
+  message(SEND_ERROR "${text}")
+  set_property(GLOBAL APPEND PROPERTY MOREA_FAILED_CASES "${label}")
+  return()
+endmacro()
+
 # expect_failure(<label> OUTPUTS <paths...> FRAGMENTS <regexes...> ARGS <morea args...>)
 #   morea must exit non-zero; stderr must match every FRAGMENT (case-insensitive); none of the
 #   OUTPUTS (files or folders) may exist afterwards, nor temporary files beside them.
@@ -119,35 +141,35 @@ function(expect_failure label)
   string(REPLACE ";" " " cmdline "${X_ARGS}")
   set(context "\n  command: morea ${cmdline}\n--- stdout:\n${out}\n--- stderr:\n${err}")
   if(rc STREQUAL "0")
-    message(FATAL_ERROR "${label}: morea succeeded on a bad input${context}")
+    case_failed("${label}: morea succeeded on a bad input${context}")
   endif()
   if(NOT rc MATCHES "^[0-9]+$")
-    message(FATAL_ERROR "${label}: morea did not exit normally ('${rc}')${context}")
+    case_failed("${label}: morea did not exit normally ('${rc}')${context}")
   endif()
   # Libraries may print warnings first (MetaIO does); the error line must be there.
   if(NOT X_USAGE AND NOT err MATCHES "(^|\n)morea: error: ")
-    message(FATAL_ERROR "${label}: stderr has no line starting with 'morea: error: '${context}")
+    case_failed("${label}: stderr has no line starting with 'morea: error: '${context}")
   endif()
   string(TOLOWER "${err}" err_lower)
   foreach(fragment IN LISTS X_FRAGMENTS)
     string(TOLOWER "${fragment}" fragment_lower)
     if(NOT err_lower MATCHES "${fragment_lower}")
-      message(FATAL_ERROR "${label}: the message does not mention '${fragment}'${context}")
+      case_failed("${label}: the message does not mention '${fragment}'${context}")
     endif()
   endforeach()
   foreach(path IN LISTS X_OUTPUTS)
     if(EXISTS "${path}")
       if(IS_DIRECTORY "${path}")
         file(GLOB_RECURSE contents LIST_DIRECTORIES true "${path}/*")
-        message(FATAL_ERROR "${label}: output folder '${path}' was created (holding: ${contents})${context}")
+        case_failed("${label}: output folder '${path}' was created (holding: ${contents})${context}")
       endif()
-      message(FATAL_ERROR "${label}: output '${path}' was written${context}")
+      case_failed("${label}: output '${path}' was written${context}")
     endif()
     get_filename_component(parent "${path}" DIRECTORY)
     get_filename_component(stem "${path}" NAME_WE)
     file(GLOB temporaries "${parent}/.${stem}.tmp*")
     if(temporaries)
-      message(FATAL_ERROR "${label}: temporary files were left behind: ${temporaries}${context}")
+      case_failed("${label}: temporary files were left behind: ${temporaries}${context}")
     endif()
   endforeach()
   string(REGEX MATCH "morea: error: [^\n]*" error_line "${err}")
@@ -212,8 +234,14 @@ expect_failure("text file named .nii.gz" OUTPUTS ${o}
 
 evaluate_outputs(o truncated)
 expect_failure("truncated .mha" OUTPUTS ${o}
-  FRAGMENTS "truncated\\.mha" "cannot read"
+  FRAGMENTS "truncated\\.mha" "is truncated"
   ARGS evaluate --fixed "${fixed}" --moving "${in}/truncated.mha" -o "${WORK}/truncated.json" --render "${WORK}/truncated")
+
+evaluate_outputs(o truncatednii)
+expect_failure("truncated .nii.gz" OUTPUTS ${o}
+  FRAGMENTS "truncated\\.nii\\.gz"
+  ARGS evaluate --fixed "${fixed}" --moving "${in}/truncated.nii.gz" -o "${WORK}/truncatednii.json"
+       --render "${WORK}/truncatednii")
 
 evaluate_outputs(o zero)
 expect_failure("zero spacing" OUTPUTS ${o}
@@ -334,7 +362,7 @@ expect_failure("preprocess without -o" USAGE
   ARGS preprocess --fixed "${fixed}" --moving "${moving}" ${blob})
 
 expect_failure("unknown subcommand" USAGE
-  FRAGMENTS "frobnicate"
+  FRAGMENTS "subcommand"
   ARGS frobnicate)
 
 expect_failure("no subcommand" USAGE
@@ -346,4 +374,10 @@ expect_failure("non-numeric border margin" USAGE OUTPUTS ${o}
   FRAGMENTS "border-margin"
   ARGS evaluate --fixed "${fixed}" --moving "${moving}" --border-margin wide -o "${WORK}/badmargin.json")
 
+get_property(failed GLOBAL PROPERTY MOREA_FAILED_CASES)
+if(failed)
+  list(LENGTH failed n)
+  string(REPLACE ";" "\n  " failed "${failed}")
+  message(FATAL_ERROR "cli.bad_inputs: ${n} case(s) failed:\n  ${failed}")
+endif()
 message(STATUS "cli.bad_inputs: all checks passed")

@@ -187,10 +187,10 @@ endif()
 
 # --- a TOML parameter file with a $placeholder filled by --var --------------------------------------
 # The margin shrinks from the default 30 mm to 20 mm, so the crop must not grow and must shrink somewhere.
-# A '$' in a comment and in a literal string is not a placeholder.
+# Placeholders are substituted in values and strings, but not in comments.
 file(WRITE "${WORK}/params.toml" [=[
 # Preprocessing for the CLI test; costs $nothing (a comment is not substituted).
-problem_id = 'phantom $literal'
+problem_id = "phantom, crop margin $margin mm"
 preprocess_isotropic_spacing = 3.0
 preprocess_crop_margin = $margin
 ]=])
