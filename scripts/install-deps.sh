@@ -7,6 +7,8 @@ packages=(
   build-essential cmake git pkg-config
   libinsighttoolkit5-dev   # ITK 5.2 (IO incl. GDCM/DICOM, registration v4, filters)
   libdcmtk-dev             # DICOM RT Structure Set import (dcmrt)
+  libtet1.5-dev            # TetGen: constrained Delaunay tetrahedralisation of the mesh
+  libvtk9-dev              # VTK: structure surfaces (marching cubes, decimation), .vtu export
   libtomlplusplus-dev      # TOML parameter files
   libcli11-dev             # command-line parsing
   nlohmann-json3-dev       # JSON outputs

@@ -10,6 +10,7 @@
 #include <map>
 #include <string>
 #include <variant>
+#include <utility>
 #include <vector>
 
 namespace morea
@@ -89,6 +90,15 @@ private:
 std::string
 SubstitutePlaceholders(const std::string & text, const std::map<std::string, std::string> & variables,
                        const std::string & sourceName);
+
+/** Parses "name=value, name=value" (names without '=' or ','; finite values);
+ *  `key` names the parameter in error messages. Empty text gives an empty list. */
+std::vector<std::pair<std::string, double>>
+ParseNamedValues(const std::string & text, const std::string & key);
+
+/** Splits "a, b, c" into trimmed non-empty names. */
+std::vector<std::string>
+ParseNameList(const std::string & text);
 
 } // namespace morea
 

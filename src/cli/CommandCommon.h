@@ -82,6 +82,8 @@ AddPreprocessCommand(CLI::App & app);
 void
 AddEvaluateCommand(CLI::App & app);
 void
+AddMeshCommand(CLI::App & app);
+void
 AddDemoCommand(CLI::App & app);
 void
 AddInfoCommand(CLI::App & app);

@@ -15,6 +15,7 @@ main(int argc, char ** argv)
   morea::cli::AddPhantomCommand(app);
   morea::cli::AddPreprocessCommand(app);
   morea::cli::AddEvaluateCommand(app);
+  morea::cli::AddMeshCommand(app);
   morea::cli::AddDemoCommand(app);
   morea::cli::AddInfoCommand(app);
   try

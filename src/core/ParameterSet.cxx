@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -70,6 +71,14 @@ MakeSpecs()
     Text("morea_mesh_generation_method", "annotation-group-random-bladder-10", {},
          "mesh point placement strategy"),
     Int("morea_mesh_num_points", 600, 8, 1e6, "points per mesh"),
+    Text("morea_mesh_surface_structures", "bladder", {},
+         "structures whose surface constrains the mesh (comma-separated; used by methods naming 'bladder')"),
+    Text("morea_mesh_structure_shares", "", {},
+         "share of contour points per structure, e.g. \"bladder=2, bones=1\" (unnamed structures: 1)"),
+    Real("morea_mesh_boundary_fraction", 0.25, 0.0, 1.0,
+         "fraction of the random mesh points placed on the domain's faces (they slide within them)"),
+    Text("morea_elasticity_factors", "bones=10, bladder=0.5", {},
+         "tissue elasticity factors of the deformation magnitude, structure=factor (others: 1)"),
     Int("morea_max_num_mesh_levels", 1, 1, 1, "mesh levels (single resolution only)"),
     Int("morea_num_generations_per_level", 0, 0, 1e7, "generations per mesh level"),
     Text("morea_magnitude_metric", "biomechanical", { "biomechanical", "standard" },
@@ -487,6 +496,54 @@ ParameterSet::ToToml() const
     os << spec.key << " = " << ValueText(m_Values.at(spec.key), true) << "\n";
   }
   return os.str();
+}
+
+namespace
+{
+std::string
+Trim(const std::string & s)
+{
+  const auto b = s.find_first_not_of(" \t");
+  if (b == std::string::npos)
+    return {};
+  const auto e = s.find_last_not_of(" \t");
+  return s.substr(b, e - b + 1);
+}
+} // namespace
+
+std::vector<std::string>
+ParseNameList(const std::string & text)
+{
+  std::vector<std::string> names;
+  std::stringstream        in(text);
+  std::string              item;
+  while (std::getline(in, item, ','))
+  {
+    item = Trim(item);
+    if (!item.empty())
+      names.push_back(item);
+  }
+  return names;
+}
+
+std::vector<std::pair<std::string, double>>
+ParseNamedValues(const std::string & text, const std::string & key)
+{
+  std::vector<std::pair<std::string, double>> result;
+  for (const std::string & item : ParseNameList(text))
+  {
+    const auto eq = item.find('=');
+    const std::string name = eq == std::string::npos ? std::string{} : Trim(item.substr(0, eq));
+    const std::string value = eq == std::string::npos ? std::string{} : Trim(item.substr(eq + 1));
+    char *            end = nullptr;
+    const double      v = value.empty() ? 0.0 : std::strtod(value.c_str(), &end);
+    if (name.empty() || value.empty() || end == nullptr || *end != '\0' || !std::isfinite(v))
+    {
+      throw Error("parameter " + key + ": \"" + item + "\" is not of the form name=number");
+    }
+    result.emplace_back(name, v);
+  }
+  return result;
 }
 
 } // namespace morea

@@ -1,0 +1,71 @@
+/*=========================================================================
+ *  MultiObjectiveRegistration: the mesh model of a preprocessed problem.
+ *
+ *  Builds, on the moving (source) image of a preprocessed problem (both
+ *  images on one grid), the base tetrahedral mesh (SPEC 4.3), its parallel
+ *  structure (4.4) and the per-tetrahedron elasticity factors (4.5), and
+ *  exports solutions' meshes for ParaView.
+ *=========================================================================*/
+#ifndef itkMeshModel_h
+#define itkMeshModel_h
+
+#include "itkMeshTransforms.h"
+#include "itkRegistrationProblem.h"
+#include "morea/MeshGenerator.h"
+#include "morea/ParallelStructure.h"
+
+#include <string>
+#include <vector>
+
+namespace morea
+{
+class ParameterSet;
+}
+
+namespace itk
+{
+namespace morea
+{
+struct MeshModelReport
+{
+  ::morea::MeshGenerationReport generation;
+  std::size_t                   fosElements{ 0 };
+  std::size_t                   parallelGroups{ 0 };
+  double                        secondsContourPoints{ 0.0 };
+  double                        secondsParallelStructure{ 0.0 };
+  double                        secondsElasticity{ 0.0 };
+  std::vector<std::string>      notes;
+};
+
+struct MeshModel
+{
+  DomainFrame                     frame;
+  ::morea::TetrahedralMesh        base;
+  ::morea::MeshTopology           topology;
+  ::morea::ParallelStructure      parallel;
+  std::vector<double>             elasticity;      ///< per tetrahedron
+  std::vector<std::string>        structureNames;  ///< indices of base.structures
+  MeshModelReport                 report;
+};
+
+/** The structures the mesh follows: those named by problem_guidance_selection
+ *  ("-1": all but "body"). Throws on a name the problem does not have. */
+std::vector<std::string>
+GuidanceStructureNames(const RegistrationProblem & problem, const ::morea::ParameterSet & parameters);
+
+/** Builds the mesh model of a preprocessed problem (both images on one grid)
+ *  from the morea_mesh_* keys, morea_elasticity_factors (used when
+ *  morea_magnitude_metric is "biomechanical") and seed. */
+MeshModel
+BuildMeshModel(const RegistrationProblem & problem, const ::morea::ParameterSet & parameters);
+
+/** Writes both meshes of `solution` as .vtu files in physical space with cell
+ *  data "elasticity" and "signed_volume" and point data "origin" (corner,
+ *  face, random, contour, surface, Steiner, refinement as 0..6) and "structure". */
+void
+WriteSolutionMeshes(const MeshModel & model, const ::morea::DualMesh & solution, const std::string & movingPath,
+                    const std::string & fixedPath);
+} // namespace morea
+} // namespace itk
+
+#endif

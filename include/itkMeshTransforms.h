@@ -1,0 +1,123 @@
+/*=========================================================================
+ *  MultiObjectiveRegistration: the core's mesh solutions as ITK displacement
+ *  fields and transforms, and mesh export in physical space.
+ *
+ *  The core works in the domain frame: millimetres along the image grid's
+ *  axes. For an image direction D (orthonormal columns), a physical point p
+ *  has frame coordinates q = D^T p, so the grid (origin o, spacing s) is the
+ *  axis-aligned core volume with origin D^T o and spacing s. With an identity
+ *  direction the frame is physical space.
+ *=========================================================================*/
+#ifndef itkMeshTransforms_h
+#define itkMeshTransforms_h
+
+#include "itkDisplacementFieldTransform.h"
+#include "itkMOREATypes.h"
+#include "morea/MeshRasterizer.h"
+#include "morea/TetrahedralMesh.h"
+#include "morea/VtuWriter.h"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace itk
+{
+namespace morea
+{
+using DisplacementFieldTransformType = DisplacementFieldTransform<double, Dimension>;
+
+/** The rotation between physical space and the core's domain frame. */
+class DomainFrame
+{
+public:
+  using DirectionType = ImageBase<Dimension>::DirectionType;
+
+  /** Identity: frame == physical space. */
+  DomainFrame();
+  /** Throws unless `direction` is orthonormal (to 1e-6). */
+  explicit DomainFrame(const DirectionType & direction);
+  /** The frame of an image grid. */
+  static DomainFrame
+  Of(const ImageBase<Dimension> * grid);
+
+  const DirectionType &
+  GetDirection() const
+  {
+    return m_Direction;
+  }
+  /** Whether `grid`'s axes are the frame's axes (to `tolerance`). */
+  bool
+  IsAlignedWith(const ImageBase<Dimension> * grid, double tolerance = 1e-6) const;
+
+  ::morea::Vec3
+  ToFrame(const PointType & physical) const;
+  PointType
+  ToPhysical(const ::morea::Vec3 & frame) const;
+  /** Displacements: the same rotation (the frame shares physical space's origin). */
+  ::morea::Vec3
+  VectorToFrame(const DisplacementVectorType & physical) const;
+  DisplacementVectorType
+  VectorToPhysical(const ::morea::Vec3 & frame) const;
+
+  /** The grid of `grid` (its largest possible region) as an axis-aligned core
+   *  displacement volume in this frame, filled with zeros. Throws unless the
+   *  grid is aligned with the frame. */
+  ::morea::Volume<::morea::Vec3>
+  FieldGridOf(const ImageBase<Dimension> * grid) const;
+
+private:
+  DirectionType m_Direction;
+};
+
+/** Core volumes in `frame` to ITK images with full geometry (origin, spacing,
+ *  direction), and back. The ITK images must be fully buffered and aligned with
+ *  the frame. */
+ImageType::Pointer
+ToImage(const ::morea::Volume<float> & volume, const DomainFrame & frame);
+MaskType::Pointer
+ToMask(const ::morea::Volume<std::uint8_t> & volume, const DomainFrame & frame);
+::morea::Volume<float>
+ToVolume(const ImageType * image, const DomainFrame & frame);
+::morea::Volume<std::uint8_t>
+ToVolume(const MaskType * mask, const DomainFrame & frame);
+
+/** A solution's registration as ITK fields and transforms (physical space). */
+struct MeshFields
+{
+  /** u(x) on the fixed grid with x + u(x) the moving point matching fixed x. */
+  DisplacementFieldType::Pointer fixedToMoving;
+  /** u(y) on the moving grid with y + u(y) the fixed point matching moving y. */
+  DisplacementFieldType::Pointer movingToFixed;
+  /** Maps fixed points to moving points: the transform ITK resamples the moving
+   *  image onto the fixed grid with. Its inverse field is set (on the fixed
+   *  grid, as ITK requires), so GetInverseTransform() works. */
+  DisplacementFieldTransformType::Pointer fixedToMovingTransform;
+  /** Maps moving points to fixed points (fields on the moving grid). */
+  DisplacementFieldTransformType::Pointer movingToFixedTransform;
+  /** Rasterisation of fixedToMoving and movingToFixed (voxels outside the mesh). */
+  ::morea::RasterizationReport fixedReport;
+  ::morea::RasterizationReport movingReport;
+};
+
+/** Rasterises a solution: `solution.target` is the mesh on the fixed image and
+ *  `solution.source` the mesh on the moving image, both in the domain frame of
+ *  the grids, which must share their direction. When the grids differ, each
+ *  transform's inverse field is rasterised once more on its forward field's
+ *  grid (the piecewise-affine map is extrapolated outside the mesh). */
+MeshFields
+RasterizeSolution(const ::morea::MeshTopology & topology, const ::morea::DualMesh & solution,
+                  const ImageBase<Dimension> * fixedGrid, const ImageBase<Dimension> * movingGrid);
+
+/** Writes a mesh given in `frame` coordinates as a .vtu in physical space
+ *  (ParaView, 3D Slicer); atomic. Tetrahedra are reordered to stay positively
+ *  oriented when the direction is a reflection. */
+void
+WriteMeshVtu(const std::string & path, const ::morea::MeshTopology & topology,
+             const std::vector<::morea::Vec3> & framePoints, const DomainFrame & frame,
+             const std::vector<::morea::VtuArray> & cellData, const std::vector<::morea::VtuArray> & pointData = {});
+
+} // namespace morea
+} // namespace itk
+
+#endif

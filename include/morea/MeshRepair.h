@@ -1,0 +1,52 @@
+// MultiObjectiveRegistration core: the Gaussian repair operator (SPEC 5,
+// morea_repair_method = "gaussian") that moves points of folded tetrahedra
+// until the mesh is fold-free again.
+#ifndef morea_MeshRepair_h
+#define morea_MeshRepair_h
+
+#include "morea/FoldConstraint.h"
+#include "morea/Random.h"
+#include "morea/TetrahedralMesh.h"
+
+#include <cstddef>
+#include <vector>
+
+namespace morea
+{
+struct RepairOptions
+{
+  std::size_t samplesPerPoint{ 64 };
+  std::size_t maxRounds{ 10 }; ///< passes over the points of folded tetrahedra
+};
+
+struct RepairResult
+{
+  FoldViolation before;
+  FoldViolation after;
+  std::size_t   movedPoints{ 0 };
+
+  bool
+  Repaired() const
+  {
+    return after.Feasible();
+  }
+};
+
+/** Repairs one mesh (`points`, with the base mesh's pins and domain) in place.
+ *  Each point of a folded tetrahedron draws `samplesPerPoint` Gaussian moves
+ *  whose scale is the point's mean distance to the planes of the faces
+ *  opposite it (its surrounding polyhedron); the move that lowers the
+ *  violation of the point's tetrahedra most is kept. A point whose samples all
+ *  make things worse is left alone; the repair stops when a whole pass moves
+ *  nothing, when the mesh is fold-free, or after maxRounds passes. */
+RepairResult
+RepairFolds(std::vector<Vec3> & points, const TetrahedralMesh & base, const FoldConstraint & constraint,
+            RandomGenerator & random, const RepairOptions & options = {});
+
+/** Both meshes of a solution. */
+RepairResult
+RepairFolds(DualMesh & solution, const TetrahedralMesh & base, const FoldConstraint & constraint,
+            RandomGenerator & random, const RepairOptions & options = {});
+} // namespace morea
+
+#endif

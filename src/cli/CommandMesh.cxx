@@ -1,0 +1,114 @@
+// `morea mesh`: builds the mesh model of a problem and writes it for inspection.
+#include "CommandCommon.h"
+
+#include "itkMOREAImageIO.h"
+#include "itkMeshModel.h"
+#include "itkPreprocessing.h"
+#include "morea/FoldConstraint.h"
+#include "morea/InitialPopulation.h"
+
+#include <chrono>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+
+namespace morea::cli
+{
+namespace
+{
+nlohmann::json
+ReportToJson(const itk::morea::MeshModel & model)
+{
+  const auto &   g = model.report.generation;
+  nlohmann::json j;
+  j["points"] = model.base.NumberOfPoints();
+  j["points_by_origin"] = { { "corner", g.corners },   { "boundary_face", g.boundaryPoints },
+                            { "random", g.randomPoints }, { "contour", g.contourPoints },
+                            { "surface", g.surfacePoints }, { "steiner", g.steinerPoints } };
+  nlohmann::json perStructure = nlohmann::json::object();
+  for (const auto & [name, count] : g.pointsPerStructure)
+    perStructure[name] = count;
+  j["points_per_structure"] = perStructure;
+  j["surface_triangles"] = g.surfaceTriangles;
+  j["tetrahedra"] = model.base.NumberOfTetrahedra();
+  j["slivers"] = g.slivers;
+  j["worst_quality"] = g.worstQuality;
+  j["points_by_origin"]["refinement"] = g.refinementPoints;
+  j["edges"] = model.topology.Edges().size();
+  j["fos_elements"] = model.report.fosElements;
+  j["parallel_groups"] = model.report.parallelGroups;
+  const auto [lo, hi] = std::minmax_element(model.elasticity.begin(), model.elasticity.end());
+  j["elasticity_range"] = { model.elasticity.empty() ? 1.0 : *lo, model.elasticity.empty() ? 1.0 : *hi };
+  j["seconds"] = { { "contour_points", model.report.secondsContourPoints },
+                   { "placement", g.secondsPlacement },
+                   { "surfaces", g.secondsSurfaces },
+                   { "tetrahedralization", g.secondsTetrahedralization },
+                   { "parallel_structure", model.report.secondsParallelStructure },
+                   { "elasticity", model.report.secondsElasticity } };
+  j["notes"] = model.report.notes;
+  return j;
+}
+} // namespace
+
+void
+AddMeshCommand(CLI::App & app)
+{
+  struct Options
+  {
+    ProblemOptions   problem;
+    ParameterOptions parameters;
+    std::string      output;
+    std::size_t      samples{ 0 };
+  };
+  auto   options = std::make_shared<Options>();
+  auto * cmd = app.add_subcommand("mesh", "build the mesh model of a problem and write it as .vtu (SPEC 4.3-4.5)");
+  options->problem.AddTo(*cmd);
+  options->parameters.AddTo(*cmd);
+  cmd->add_option("-o,--output", options->output, "output folder")->required();
+  cmd->add_option("--samples", options->samples,
+                  "also write this many random initial solutions (meshes and displacement fields)")
+    ->check(CLI::Range(0, 1000));
+  cmd->callback([options] {
+    const auto parameters = options->parameters.Load();
+    auto       problem = options->problem.Load();
+    if (!itk::morea::SameGrid(problem.fixedImage, problem.movingImage))
+    {
+      std::cout << "the images are on different grids: preprocessing first\n";
+      problem = itk::morea::Preprocess(problem, itk::morea::PreprocessOptions::FromParameters(parameters)).problem;
+    }
+    const auto model = itk::morea::BuildMeshModel(problem, parameters);
+    std::filesystem::create_directories(options->output);
+    const std::string out = options->output + "/";
+    const auto        base = ::morea::DualMesh::FromBase(model.base);
+    itk::morea::WriteSolutionMeshes(model, base, out + "mesh_moving.vtu", out + "mesh_fixed.vtu");
+
+    nlohmann::json report = ReportToJson(model);
+    if (options->samples > 0)
+    {
+      const auto                  start = std::chrono::steady_clock::now();
+      const ::morea::FoldConstraint constraint(model.topology, model.base.points);
+      const auto population = ::morea::GenerateInitialPopulation(
+        model.base, constraint, options->samples + 1, static_cast<std::uint64_t>(parameters.GetInteger("seed")),
+        ::morea::InitialPopulationOptions::FromParameters(parameters));
+      for (std::size_t i = 1; i < population.size(); ++i)
+      {
+        const std::string prefix = out + "initial_" + std::to_string(i) + "_";
+        itk::morea::WriteSolutionMeshes(model, population[i], prefix + "mesh_moving.vtu", prefix + "mesh_fixed.vtu");
+        const auto fields = itk::morea::RasterizeSolution(model.topology, population[i], problem.fixedImage,
+                                                          problem.movingImage);
+        itk::morea::WriteDisplacementField(fields.fixedToMoving, prefix + "fixed_to_moving.nii.gz");
+        itk::morea::WriteDisplacementField(fields.movingToFixed, prefix + "moving_to_fixed.nii.gz");
+      }
+      report["seconds"]["samples"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    }
+    WriteJson(report, out + "mesh.json");
+
+    std::cout << "mesh: " << model.base.NumberOfPoints() << " points, " << model.base.NumberOfTetrahedra()
+              << " tetrahedra, " << model.report.fosElements << " FOS elements in " << model.report.parallelGroups
+              << " parallel groups\n";
+    for (const auto & note : model.report.notes)
+      std::cout << "note: " << note << "\n";
+    std::cout << "written to " << options->output << "\n";
+  });
+}
+} // namespace morea::cli

@@ -1,0 +1,88 @@
+#include "morea/FoldConstraint.h"
+
+#include "morea/Error.h"
+
+#include <cmath>
+
+namespace morea
+{
+FoldConstraint::FoldConstraint(const MeshTopology & topology, const std::vector<Vec3> & reference)
+  : m_Topology(&topology)
+{
+  if (reference.size() != topology.NumberOfPoints())
+    throw Error("fold constraint: reference has " + std::to_string(reference.size()) + " points, the mesh " +
+                std::to_string(topology.NumberOfPoints()));
+  m_ReferenceSigns.reserve(topology.NumberOfTetrahedra());
+  for (const Tetrahedron & t : topology.Tetrahedra())
+  {
+    const double v = SignedVolume(t, reference);
+    if (v == 0.0)
+      throw Error("fold constraint: the base mesh has a flat tetrahedron");
+    m_ReferenceSigns.push_back(v > 0.0 ? 1 : -1);
+  }
+}
+
+double
+FoldConstraint::TetrahedronViolation(std::size_t t, const std::vector<Vec3> & points, bool & folded) const
+{
+  const double v = SignedVolume(m_Topology->Tetrahedra()[t], points);
+  folded = !(v * m_ReferenceSigns[t] > 0.0);
+  return folded ? std::abs(v) : 0.0;
+}
+
+FoldViolation
+FoldConstraint::Evaluate(const std::vector<Vec3> & points, std::vector<double> * perTetrahedron) const
+{
+  if (points.size() != m_Topology->NumberOfPoints())
+    throw Error("fold constraint: solution has " + std::to_string(points.size()) + " points, the mesh " +
+                std::to_string(m_Topology->NumberOfPoints()));
+  FoldViolation total;
+  if (perTetrahedron)
+    perTetrahedron->assign(m_Topology->NumberOfTetrahedra(), 0.0);
+  for (std::size_t t = 0; t < m_Topology->NumberOfTetrahedra(); ++t)
+  {
+    bool         folded = false;
+    const double v = TetrahedronViolation(t, points, folded);
+    total.value += v;
+    total.folded += folded;
+    if (perTetrahedron)
+      (*perTetrahedron)[t] = v;
+  }
+  return total;
+}
+
+FoldViolation
+FoldConstraint::Evaluate(const DualMesh & solution) const
+{
+  FoldViolation total = Evaluate(solution.source);
+  total += Evaluate(solution.target);
+  return total;
+}
+
+FoldViolation
+FoldConstraint::Partial(const std::vector<Vec3> & points, const std::vector<std::uint32_t> & touched) const
+{
+  FoldViolation total;
+  for (std::uint32_t t : touched)
+  {
+    bool folded = false;
+    total.value += TetrahedronViolation(t, points, folded);
+    total.folded += folded;
+  }
+  return total;
+}
+
+std::vector<std::uint32_t>
+FoldConstraint::FoldedTetrahedra(const std::vector<Vec3> & points) const
+{
+  std::vector<std::uint32_t> folded;
+  for (std::size_t t = 0; t < m_Topology->NumberOfTetrahedra(); ++t)
+  {
+    bool f = false;
+    TetrahedronViolation(t, points, f);
+    if (f)
+      folded.push_back(static_cast<std::uint32_t>(t));
+  }
+  return folded;
+}
+} // namespace morea

@@ -1,0 +1,114 @@
+#include "morea/MeshRepair.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace morea
+{
+namespace
+{
+/** Mean distance of `point` to the planes of the faces opposite it in its tetrahedra. */
+double
+DistanceToSurroundingPolyhedron(std::uint32_t point, const std::vector<Vec3> & points, const MeshTopology & topology)
+{
+  double      sum = 0.0;
+  std::size_t n = 0;
+  const Vec3 & p = points[point];
+  for (const std::uint32_t * t = topology.TetrahedraOfPointBegin(point); t != topology.TetrahedraOfPointEnd(point); ++t)
+  {
+    const Tetrahedron & tet = topology.Tetrahedra()[*t];
+    Vec3                f[3];
+    int                 m = 0;
+    for (std::uint32_t v : tet)
+      if (v != point)
+        f[m++] = points[v];
+    const Vec3   u{ { f[1][0] - f[0][0], f[1][1] - f[0][1], f[1][2] - f[0][2] } };
+    const Vec3   w{ { f[2][0] - f[0][0], f[2][1] - f[0][1], f[2][2] - f[0][2] } };
+    const Vec3   normal{ { u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0] } };
+    const double area2 = std::sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
+    if (area2 == 0.0)
+      continue;
+    sum += std::abs(normal[0] * (p[0] - f[0][0]) + normal[1] * (p[1] - f[0][1]) + normal[2] * (p[2] - f[0][2])) / area2;
+    ++n;
+  }
+  return n ? sum / static_cast<double>(n) : 0.0;
+}
+
+bool
+Better(const FoldViolation & a, const FoldViolation & b)
+{
+  return a.value < b.value || (a.value <= b.value && a.folded < b.folded);
+}
+} // namespace
+
+RepairResult
+RepairFolds(std::vector<Vec3> & points, const TetrahedralMesh & base, const FoldConstraint & constraint,
+            RandomGenerator & random, const RepairOptions & options)
+{
+  const MeshTopology & topology = constraint.Topology();
+  RepairResult         result;
+  result.before = constraint.Evaluate(points);
+  result.after = result.before;
+  for (std::size_t round = 0; round < options.maxRounds && !result.after.Feasible(); ++round)
+  {
+    std::vector<std::uint32_t> candidates;
+    for (std::uint32_t t : constraint.FoldedTetrahedra(points))
+      for (std::uint32_t v : topology.Tetrahedra()[t])
+        candidates.push_back(v);
+    std::sort(candidates.begin(), candidates.end());
+    candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+
+    bool moved = false;
+    for (std::uint32_t p : candidates)
+    {
+      const BoundaryPin & pin = base.pins[p];
+      if (pin[0] != 0 && pin[1] != 0 && pin[2] != 0)
+        continue; // corners never move
+      const std::vector<std::uint32_t> local = topology.TetrahedraOfPoint(p);
+      const FoldViolation              current = constraint.Partial(points, local);
+      if (current.Feasible())
+        continue; // fixed by an earlier move in this pass
+      const double scale = DistanceToSurroundingPolyhedron(p, points, topology);
+      if (!(scale > 0.0))
+        continue;
+      const Vec3    original = points[p];
+      Vec3          bestPosition = original;
+      FoldViolation best = current;
+      for (std::size_t s = 0; s < options.samplesPerPoint; ++s)
+      {
+        const Vec3 trial{ { original[0] + scale * random.Normal(), original[1] + scale * random.Normal(),
+                            original[2] + scale * random.Normal() } };
+        points[p] = ProjectToDomain(trial, pin, base.domain);
+        const FoldViolation v = constraint.Partial(points, local);
+        if (Better(v, best))
+        {
+          best = v;
+          bestPosition = points[p];
+        }
+      }
+      points[p] = bestPosition;
+      if (bestPosition != original)
+      {
+        moved = true;
+        ++result.movedPoints;
+      }
+    }
+    result.after = constraint.Evaluate(points);
+    if (!moved)
+      break;
+  }
+  return result;
+}
+
+RepairResult
+RepairFolds(DualMesh & solution, const TetrahedralMesh & base, const FoldConstraint & constraint,
+            RandomGenerator & random, const RepairOptions & options)
+{
+  RepairResult source = RepairFolds(solution.source, base, constraint, random, options);
+  RepairResult target = RepairFolds(solution.target, base, constraint, random, options);
+  source.before += target.before;
+  source.after += target.after;
+  source.movedPoints += target.movedPoints;
+  return source;
+}
+} // namespace morea

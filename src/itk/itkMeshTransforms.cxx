@@ -1,0 +1,300 @@
+#include "itkMeshTransforms.h"
+
+#include "itkMOREAImageIO.h"
+#include "itkPhantomImages.h"
+#include "itkRegistrationEvaluation.h"
+#include "morea/Error.h"
+#include "vnl/algo/vnl_determinant.h"
+
+#include <cmath>
+#include <utility>
+
+namespace itk
+{
+namespace morea
+{
+namespace
+{
+/** A core volume with the geometry of `image` in `frame` and its voxels. */
+template <typename TValue, typename TImage>
+::morea::Volume<TValue>
+ToFrameVolume(const TImage * image, const DomainFrame & frame, const char * what)
+{
+  if (image == nullptr)
+  {
+    itkGenericExceptionMacro(<< "cannot convert a null " << what);
+  }
+  if (image->GetBufferedRegion() != image->GetLargestPossibleRegion())
+  {
+    itkGenericExceptionMacro(<< "cannot convert a partly buffered " << what);
+  }
+  const auto              geometry = frame.FieldGridOf(image);
+  ::morea::Volume<TValue> volume(geometry.size, geometry.spacing, geometry.origin);
+  const auto *            buffer = image->GetBufferPointer();
+  // ITK's buffer order is the core's: x fastest, then y, then z.
+  for (std::size_t i = 0; i < volume.data.size(); ++i)
+  {
+    volume.data[i] = static_cast<TValue>(buffer[i]);
+  }
+  return volume;
+}
+
+template <typename TImage>
+void
+PlaceInFrame(TImage * image, const ::morea::Vec3 & frameOrigin, const DomainFrame & frame)
+{
+  image->SetOrigin(frame.ToPhysical(frameOrigin));
+  image->SetDirection(frame.GetDirection());
+}
+} // namespace
+
+DomainFrame::DomainFrame()
+{
+  m_Direction.SetIdentity();
+}
+
+DomainFrame::DomainFrame(const DirectionType & direction)
+  : m_Direction(direction)
+{
+  // The frame map q = D^T p is only the inverse of p = D q for a rotation (or reflection).
+  for (unsigned i = 0; i < Dimension; ++i)
+  {
+    for (unsigned j = 0; j < Dimension; ++j)
+    {
+      double dot = 0.0;
+      for (unsigned r = 0; r < Dimension; ++r)
+      {
+        dot += direction[r][i] * direction[r][j];
+      }
+      if (std::abs(dot - (i == j ? 1.0 : 0.0)) > 1e-6)
+      {
+        itkGenericExceptionMacro(<< "the image direction is not orthonormal (sheared grids are not supported): "
+                                 << direction);
+      }
+    }
+  }
+}
+
+DomainFrame
+DomainFrame::Of(const ImageBase<Dimension> * grid)
+{
+  if (grid == nullptr)
+  {
+    itkGenericExceptionMacro(<< "domain frame of a null image");
+  }
+  return DomainFrame(grid->GetDirection());
+}
+
+bool
+DomainFrame::IsAlignedWith(const ImageBase<Dimension> * grid, double tolerance) const
+{
+  for (unsigned i = 0; i < Dimension; ++i)
+  {
+    for (unsigned j = 0; j < Dimension; ++j)
+    {
+      if (std::abs(grid->GetDirection()[i][j] - m_Direction[i][j]) > tolerance)
+      {
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+::morea::Vec3
+DomainFrame::ToFrame(const PointType & physical) const
+{
+  ::morea::Vec3 q{ { 0.0, 0.0, 0.0 } };
+  for (unsigned r = 0; r < Dimension; ++r)
+  {
+    for (unsigned c = 0; c < Dimension; ++c)
+    {
+      q[r] += m_Direction[c][r] * physical[c];
+    }
+  }
+  return q;
+}
+
+PointType
+DomainFrame::ToPhysical(const ::morea::Vec3 & frame) const
+{
+  PointType p;
+  for (unsigned r = 0; r < Dimension; ++r)
+  {
+    p[r] = m_Direction[r][0] * frame[0] + m_Direction[r][1] * frame[1] + m_Direction[r][2] * frame[2];
+  }
+  return p;
+}
+
+::morea::Vec3
+DomainFrame::VectorToFrame(const DisplacementVectorType & physical) const
+{
+  PointType p;
+  for (unsigned d = 0; d < Dimension; ++d)
+  {
+    p[d] = physical[d];
+  }
+  return ToFrame(p);
+}
+
+DisplacementVectorType
+DomainFrame::VectorToPhysical(const ::morea::Vec3 & frame) const
+{
+  DisplacementVectorType v;
+  for (unsigned r = 0; r < Dimension; ++r)
+  {
+    v[r] = m_Direction[r][0] * frame[0] + m_Direction[r][1] * frame[1] + m_Direction[r][2] * frame[2];
+  }
+  return v;
+}
+
+::morea::Volume<::morea::Vec3>
+DomainFrame::FieldGridOf(const ImageBase<Dimension> * grid) const
+{
+  if (grid == nullptr)
+  {
+    itkGenericExceptionMacro(<< "grid of a null image");
+  }
+  if (!IsAlignedWith(grid))
+  {
+    itkGenericExceptionMacro(<< "the image grid's direction " << grid->GetDirection() << " is not the domain frame's "
+                             << m_Direction);
+  }
+  const auto                 region = grid->GetLargestPossibleRegion();
+  std::array<std::size_t, 3> size;
+  ::morea::Vec3              spacing;
+  for (unsigned d = 0; d < Dimension; ++d)
+  {
+    size[d] = region.GetSize()[d];
+    spacing[d] = grid->GetSpacing()[d];
+  }
+  // The region may start at a non-zero index: the core's first voxel is that one.
+  PointType first;
+  grid->TransformIndexToPhysicalPoint(region.GetIndex(), first);
+  return ::morea::Volume<::morea::Vec3>(size, spacing, ToFrame(first));
+}
+
+ImageType::Pointer
+ToImage(const ::morea::Volume<float> & volume, const DomainFrame & frame)
+{
+  ImageType::Pointer image = ToImage(volume);
+  PlaceInFrame(image.GetPointer(), volume.origin, frame);
+  return image;
+}
+
+MaskType::Pointer
+ToMask(const ::morea::Volume<std::uint8_t> & volume, const DomainFrame & frame)
+{
+  MaskType::Pointer mask = ToMask(volume);
+  PlaceInFrame(mask.GetPointer(), volume.origin, frame);
+  return mask;
+}
+
+::morea::Volume<float>
+ToVolume(const ImageType * image, const DomainFrame & frame)
+{
+  return ToFrameVolume<float>(image, frame, "image");
+}
+
+::morea::Volume<std::uint8_t>
+ToVolume(const MaskType * mask, const DomainFrame & frame)
+{
+  return ToFrameVolume<std::uint8_t>(mask, frame, "mask");
+}
+
+MeshFields
+RasterizeSolution(const ::morea::MeshTopology & topology, const ::morea::DualMesh & solution,
+                  const ImageBase<Dimension> * fixedGrid, const ImageBase<Dimension> * movingGrid)
+{
+  if (fixedGrid == nullptr || movingGrid == nullptr)
+  {
+    itkGenericExceptionMacro(<< "rasterising a solution needs both the fixed and the moving image grid");
+  }
+  const DomainFrame frame = DomainFrame::Of(fixedGrid);
+  if (!frame.IsAlignedWith(movingGrid))
+  {
+    itkGenericExceptionMacro(<< "the fixed and moving images must share their direction (one domain frame); "
+                             << "fixed: " << fixedGrid->GetDirection() << " moving: " << movingGrid->GetDirection());
+  }
+
+  // The map `from` -> `to`, sampled on `grid`, as a physical displacement field.
+  auto rasterize = [&](const std::vector<::morea::Vec3> & from,
+                       const std::vector<::morea::Vec3> & to,
+                       const ImageBase<Dimension> *       grid,
+                       ::morea::RasterizationReport *     report) {
+    auto volume = frame.FieldGridOf(grid);
+    try
+    {
+      ::morea::RasterizeDisplacement(topology, from, to, volume, report);
+    }
+    catch (const ::morea::Error & e)
+    {
+      itkGenericExceptionMacro(<< e.what());
+    }
+    DisplacementFieldType::Pointer field = MakeIdentityField(grid); // the grid's full geometry
+    DisplacementVectorType *       buffer = field->GetBufferPointer();
+    for (std::size_t i = 0; i < volume.data.size(); ++i)
+    {
+      buffer[i] = frame.VectorToPhysical(volume.data[i]);
+    }
+    return field;
+  };
+
+  MeshFields fields;
+  fields.fixedToMoving = rasterize(solution.target, solution.source, fixedGrid, &fields.fixedReport);
+  fields.movingToFixed = rasterize(solution.source, solution.target, movingGrid, &fields.movingReport);
+
+  // ITK wants a transform's inverse field on its forward field's grid.
+  const bool                     sameGrid = SameGrid(fixedGrid, movingGrid, 1e-9);
+  DisplacementFieldType::Pointer movingToFixedOnFixedGrid =
+    sameGrid ? fields.movingToFixed : rasterize(solution.source, solution.target, fixedGrid, nullptr);
+  DisplacementFieldType::Pointer fixedToMovingOnMovingGrid =
+    sameGrid ? fields.fixedToMoving : rasterize(solution.target, solution.source, movingGrid, nullptr);
+
+  fields.fixedToMovingTransform = DisplacementFieldTransformType::New();
+  fields.fixedToMovingTransform->SetDisplacementField(fields.fixedToMoving);
+  fields.fixedToMovingTransform->SetInverseDisplacementField(movingToFixedOnFixedGrid);
+  fields.movingToFixedTransform = DisplacementFieldTransformType::New();
+  fields.movingToFixedTransform->SetDisplacementField(fields.movingToFixed);
+  fields.movingToFixedTransform->SetInverseDisplacementField(fixedToMovingOnMovingGrid);
+  return fields;
+}
+
+void
+WriteMeshVtu(const std::string & path, const ::morea::MeshTopology & topology,
+             const std::vector<::morea::Vec3> & framePoints, const DomainFrame & frame,
+             const std::vector<::morea::VtuArray> & cellData, const std::vector<::morea::VtuArray> & pointData)
+{
+  if (framePoints.size() != topology.NumberOfPoints())
+  {
+    itkGenericExceptionMacro(<< "cannot write '" << path << "': the topology has " << topology.NumberOfPoints()
+                             << " points but " << framePoints.size() << " were given");
+  }
+  std::vector<::morea::Vec3> physical;
+  physical.reserve(framePoints.size());
+  for (const auto & q : framePoints)
+  {
+    const PointType p = frame.ToPhysical(q);
+    physical.push_back({ { p[0], p[1], p[2] } });
+  }
+  // A reflection flips every tetrahedron's orientation; one swap flips it back.
+  std::vector<::morea::Tetrahedron> tetrahedra = topology.Tetrahedra();
+  if (vnl_determinant(frame.GetDirection().GetVnlMatrix()) < 0.0)
+  {
+    for (auto & t : tetrahedra)
+    {
+      std::swap(t[2], t[3]);
+    }
+  }
+  try
+  {
+    ::morea::WriteVtu(path, physical, tetrahedra, cellData, pointData);
+  }
+  catch (const ::morea::Error & e)
+  {
+    itkGenericExceptionMacro(<< e.what());
+  }
+}
+
+} // namespace morea
+} // namespace itk

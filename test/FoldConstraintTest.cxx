@@ -1,0 +1,163 @@
+// Tests of fold detection, the constraint value and the Gaussian repair.
+#include "MeshTestSupport.h"
+
+#include "morea/Error.h"
+#include "morea/FoldConstraint.h"
+#include "morea/MeshRepair.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace
+{
+using morea::Vec3;
+
+// Two tetrahedra on the triangle (0,1,2) in the plane z = 0: point 3 above,
+// point 4 below. Area of the triangle: 8.
+struct TwoTetrahedra
+{
+  std::vector<Vec3>              points{ { { 0, 0, 0 } }, { { 4, 0, 0 } }, { { 0, 4, 0 } }, { { 1, 1, 3 } }, { { 1, 1, -2 } } };
+  std::vector<morea::Tetrahedron> tets{ { { 0, 1, 2, 3 } }, { { 0, 2, 1, 4 } } };
+  morea::MeshTopology            topology{ tets, 5 };
+};
+
+TEST(FoldConstraint, PlantedFoldHasTheRightSeverity)
+{
+  TwoTetrahedra         m;
+  morea::FoldConstraint constraint(m.topology, m.points);
+  EXPECT_TRUE(constraint.Evaluate(m.points).Feasible());
+  EXPECT_EQ(constraint.Evaluate(m.points).value, 0.0);
+
+  // Push point 3 through the shared face to z = -1.5: the first tetrahedron
+  // turns inside out with |volume| = 8 * 1.5 / 3 = 4; the second is untouched.
+  std::vector<Vec3> folded = m.points;
+  folded[3] = { { 1, 1, -1.5 } };
+  const auto v = constraint.Evaluate(folded);
+  EXPECT_EQ(v.folded, 1u);
+  EXPECT_NEAR(v.value, 4.0, 1e-12);
+  EXPECT_EQ(constraint.FoldedTetrahedra(folded), (std::vector<std::uint32_t>{ 0 }));
+  // Flattening it exactly onto the face is a fold of severity 0.
+  folded[3] = { { 1, 1, 0 } };
+  EXPECT_EQ(constraint.Evaluate(folded).folded, 1u);
+  EXPECT_EQ(constraint.Evaluate(folded).value, 0.0);
+
+  // Both meshes add up.
+  morea::DualMesh dual{ m.points, m.points };
+  dual.target[3] = { { 1, 1, -1.5 } };
+  dual.source[4] = { { 1, 1, 0.5 } }; // |volume| = 8 * 0.5 / 3
+  const auto both = constraint.Evaluate(dual);
+  EXPECT_EQ(both.folded, 2u);
+  EXPECT_NEAR(both.value, 4.0 + 4.0 / 3.0, 1e-12);
+}
+
+TEST(FoldConstraint, RejectsMismatchedSizesAndFlatReference)
+{
+  TwoTetrahedra m;
+  EXPECT_THROW(morea::FoldConstraint(m.topology, { m.points[0] }), morea::Error);
+  auto flat = m.points;
+  flat[3][2] = 0.0;
+  EXPECT_THROW(morea::FoldConstraint(m.topology, flat), morea::Error);
+  morea::FoldConstraint constraint(m.topology, m.points);
+  EXPECT_THROW(constraint.Evaluate(std::vector<Vec3>(3)), morea::Error);
+}
+
+TEST(FoldConstraint, TranslatedPhantomMeshHasNoFold)
+{
+  const auto &              pm = morea_test::PhantomMesh600();
+  const morea::MeshTopology topology(pm.mesh.tetrahedra, pm.mesh.NumberOfPoints());
+  morea::FoldConstraint     constraint(topology, pm.mesh.points);
+  for (const Vec3 shift : { Vec3{ { 12.5, -3.0, 40.0 } }, Vec3{ { -0.001, 0.0, 0.0 } } })
+  {
+    std::vector<Vec3> moved = pm.mesh.points;
+    for (auto & p : moved)
+      for (int a = 0; a < 3; ++a)
+        p[a] += shift[a];
+    const auto v = constraint.Evaluate(moved);
+    EXPECT_TRUE(v.Feasible());
+    EXPECT_EQ(v.value, 0.0);
+  }
+}
+
+/** Moves an inner point of the phantom mesh through the face opposite it in
+ *  one of its tetrahedra (mirrors it in that face's plane). */
+std::uint32_t
+PlantFold(std::vector<Vec3> & points, const morea::TetrahedralMesh & mesh, const morea::MeshTopology & topology,
+          std::size_t which)
+{
+  std::size_t seen = 0;
+  for (std::uint32_t p = 0; p < points.size(); ++p)
+  {
+    if (mesh.origins[p] != morea::PointOrigin::Random || seen++ != which)
+      continue;
+    const auto & tet = topology.Tetrahedra()[*topology.TetrahedraOfPointBegin(p)];
+    Vec3         f[3];
+    int          n = 0;
+    for (auto v : tet)
+      if (v != p)
+        f[n++] = points[v];
+    const Vec3   u{ { f[1][0] - f[0][0], f[1][1] - f[0][1], f[1][2] - f[0][2] } };
+    const Vec3   w{ { f[2][0] - f[0][0], f[2][1] - f[0][1], f[2][2] - f[0][2] } };
+    Vec3         nrm{ { u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0] } };
+    const double len = std::sqrt(nrm[0] * nrm[0] + nrm[1] * nrm[1] + nrm[2] * nrm[2]);
+    const double d = ((points[p][0] - f[0][0]) * nrm[0] + (points[p][1] - f[0][1]) * nrm[1] +
+                      (points[p][2] - f[0][2]) * nrm[2]) /
+                     len;
+    for (int a = 0; a < 3; ++a)
+      points[p][a] -= 2.0 * d * nrm[a] / len;
+    return p;
+  }
+  ADD_FAILURE() << "no inner point to fold";
+  return 0;
+}
+
+TEST(FoldConstraint, PartialEvaluationMatchesFullOnThePhantomMesh)
+{
+  const auto &              pm = morea_test::PhantomMesh600();
+  const morea::MeshTopology topology(pm.mesh.tetrahedra, pm.mesh.NumberOfPoints());
+  morea::FoldConstraint     constraint(topology, pm.mesh.points);
+  std::vector<Vec3>         before = pm.mesh.points;
+  std::vector<Vec3>         after = before;
+  const std::uint32_t       p = PlantFold(after, pm.mesh, topology, 3);
+  const auto                touched = topology.TetrahedraOfPoint(p);
+  const auto                full = constraint.Evaluate(after);
+  EXPECT_GE(full.folded, 1u);
+  EXPECT_GT(full.value, 0.0);
+  const auto b = constraint.Partial(before, touched), a = constraint.Partial(after, touched);
+  EXPECT_EQ(constraint.Evaluate(before).folded - b.folded + a.folded, full.folded);
+  EXPECT_NEAR(constraint.Evaluate(before).value - b.value + a.value, full.value, 1e-9 * full.value);
+  // The folded tetrahedra all contain the moved point.
+  for (auto t : constraint.FoldedTetrahedra(after))
+    EXPECT_TRUE(std::binary_search(touched.begin(), touched.end(), t));
+}
+
+TEST(MeshRepair, RepairsPlantedFoldsInBothMeshes)
+{
+  const auto &              pm = morea_test::PhantomMesh600();
+  const morea::MeshTopology topology(pm.mesh.tetrahedra, pm.mesh.NumberOfPoints());
+  morea::FoldConstraint     constraint(topology, pm.mesh.points);
+  morea::DualMesh           solution = morea::DualMesh::FromBase(pm.mesh);
+  for (std::size_t k : { 0, 5, 11 })
+    PlantFold(solution.target, pm.mesh, topology, k);
+  PlantFold(solution.source, pm.mesh, topology, 20);
+  ASSERT_FALSE(constraint.Evaluate(solution).Feasible());
+
+  morea::RandomGenerator random(42);
+  const auto             result = morea::RepairFolds(solution, pm.mesh, constraint, random);
+  EXPECT_GE(result.before.folded, 4u);
+  EXPECT_TRUE(result.Repaired()) << result.after.folded << " folded tetrahedra left";
+  EXPECT_TRUE(constraint.Evaluate(solution).Feasible());
+  EXPECT_GE(result.movedPoints, 4u);
+  for (std::size_t i = 0; i < solution.source.size(); ++i)
+  {
+    EXPECT_EQ(morea::ProjectToDomain(solution.source[i], pm.mesh.pins[i], pm.domain), solution.source[i]);
+    EXPECT_EQ(morea::ProjectToDomain(solution.target[i], pm.mesh.pins[i], pm.domain), solution.target[i]);
+  }
+
+  // A fold-free mesh is left untouched.
+  morea::DualMesh untouched = morea::DualMesh::FromBase(pm.mesh);
+  const auto      none = morea::RepairFolds(untouched, pm.mesh, constraint, random);
+  EXPECT_EQ(none.movedPoints, 0u);
+  EXPECT_EQ(untouched.target, pm.mesh.points);
+}
+} // namespace

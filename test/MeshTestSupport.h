@@ -1,0 +1,64 @@
+// Shared fixtures of the mesh model tests: a 600-point mesh of the phantom.
+#ifndef MeshTestSupport_h
+#define MeshTestSupport_h
+
+#include "morea/MeshGenerator.h"
+#include "morea/MeshPointPlacement.h"
+#include "morea/Phantom.h"
+
+#include <algorithm>
+#include <memory>
+
+namespace morea_test
+{
+struct PhantomMesh
+{
+  morea::PelvisPhantom::Case    phantomCase;
+  morea::MeshDomain             domain;
+  morea::TetrahedralMesh        mesh;
+  morea::MeshGenerationReport   report;
+  std::vector<std::string>      names;
+};
+
+/** The phantom at 3 mm; the domain is the bladder's bounding box on the moving
+ *  image plus 30 mm (as preprocessing would crop); the mesh is built on the
+ *  moving image with the bladder surface as a constraint. Built once. */
+inline const PhantomMesh &
+PhantomMesh600()
+{
+  static const std::unique_ptr<PhantomMesh> cached = [] {
+    auto                  pm = std::make_unique<PhantomMesh>();
+    morea::PhantomOptions po;
+    po.spacing = 3.0;
+    pm->phantomCase = morea::PelvisPhantom(po).Generate();
+    pm->names = morea::PelvisPhantom::StructureNames();
+    const auto & bladder = pm->phantomCase.movingMasks[2];
+    morea::Vec3  lo{ { 1e9, 1e9, 1e9 } }, hi{ { -1e9, -1e9, -1e9 } };
+    for (const morea::Vec3 & p : morea::MaskBoundaryPoints(bladder))
+      for (int a = 0; a < 3; ++a)
+      {
+        lo[a] = std::min(lo[a], p[a]);
+        hi[a] = std::max(hi[a], p[a]);
+      }
+    const morea::MeshDomain full = morea::MeshDomain::OfGrid(bladder);
+    for (int a = 0; a < 3; ++a)
+    {
+      pm->domain.lower[a] = std::max(full.lower[a], lo[a] - 30.0);
+      pm->domain.upper[a] = std::min(full.upper[a], hi[a] + 30.0);
+    }
+    std::vector<morea::MeshStructure> structures;
+    for (std::size_t s = 1; s < pm->names.size(); ++s) // all but the body
+    {
+      structures.push_back({ pm->names[s], morea::MaskBoundaryPoints(pm->phantomCase.movingMasks[s]),
+                             &pm->phantomCase.movingMasks[s] });
+    }
+    morea::MeshGeneratorOptions options; // 600 points, bladder surface
+    options.seed = 7;
+    pm->mesh = morea::GenerateMesh(pm->domain, structures, options, &pm->report);
+    return pm;
+  }();
+  return *cached;
+}
+} // namespace morea_test
+
+#endif

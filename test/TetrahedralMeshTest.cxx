@@ -1,0 +1,238 @@
+// Tests of the mesh model's geometry, point placement, tetrahedralisation and
+// the generated phantom mesh.
+#include "MeshTestSupport.h"
+
+#include "morea/Error.h"
+#include "morea/MeshGenerator.h"
+#include "morea/MeshPointPlacement.h"
+#include "morea/ParameterSet.h"
+#include "morea/StructureSurface.h"
+#include "morea/Tetrahedralization.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <iostream>
+#include <set>
+
+namespace
+{
+using morea::Tetrahedron;
+using morea::Vec3;
+
+double
+Distance(const Vec3 & a, const Vec3 & b)
+{
+  return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+}
+
+TEST(TetrahedralMesh, SignedVolumeOfUnitCornerTetrahedron)
+{
+  const Vec3 o{ { 0, 0, 0 } }, x{ { 2, 0, 0 } }, y{ { 0, 3, 0 } }, z{ { 0, 0, 4 } };
+  EXPECT_DOUBLE_EQ(morea::SignedVolume(o, x, y, z), 4.0);
+  EXPECT_DOUBLE_EQ(morea::SignedVolume(o, y, x, z), -4.0);
+  EXPECT_DOUBLE_EQ(morea::SignedVolume(o, x, x, z), 0.0);
+}
+
+TEST(TetrahedralMesh, TopologyListsTetrahedraEdgesAndNeighbours)
+{
+  // Two tetrahedra sharing the face (0,1,2).
+  const std::vector<Tetrahedron> tets{ { { 0, 1, 2, 3 } }, { { 0, 2, 1, 4 } } };
+  const morea::MeshTopology      topology(tets, 5);
+  EXPECT_EQ(topology.NumberOfPoints(), 5u);
+  EXPECT_EQ(topology.Edges().size(), 9u); // 3 shared + 3 + 3
+  EXPECT_EQ(topology.TetrahedraOfPoint(0), (std::vector<std::uint32_t>{ 0, 1 }));
+  EXPECT_EQ(topology.TetrahedraOfPoint(3), (std::vector<std::uint32_t>{ 0 }));
+  EXPECT_EQ(topology.Neighbours(3), (std::vector<std::uint32_t>{ 0, 1, 2 }));
+  EXPECT_EQ(topology.Neighbours(0), (std::vector<std::uint32_t>{ 1, 2, 3, 4 }));
+  EXPECT_THROW(morea::MeshTopology(tets, 4), morea::Error);
+}
+
+TEST(TetrahedralMesh, PinsAndProjectionKeepPointsOnTheirFaces)
+{
+  morea::MeshDomain d;
+  d.lower = { { 0, 0, 0 } };
+  d.upper = { { 10, 20, 30 } };
+  EXPECT_EQ(morea::PinOf({ { 0, 5, 30 } }, d, 1e-9), (morea::BoundaryPin{ { -1, 0, 1 } }));
+  EXPECT_EQ(morea::PinOf({ { 5, 5, 5 } }, d, 1e-9), (morea::BoundaryPin{ { 0, 0, 0 } }));
+  const Vec3 q = morea::ProjectToDomain({ { 3, -4, 31 } }, { { -1, 0, 0 } }, d);
+  EXPECT_EQ(q, (Vec3{ { 0, 0, 30 } }));
+}
+
+TEST(MeshPointPlacement, SpreadOutSubsetPicksFarthestPoints)
+{
+  // Points on a line 0..100: from an existing point at 0 the farthest-first
+  // order is 100, 50, then 25 or 75.
+  std::vector<Vec3> line;
+  for (int i = 0; i <= 100; ++i)
+    line.push_back({ { double(i), 0, 0 } });
+  const auto chosen = morea::SpreadOutSubset(line, 3, { { { 0, 0, 0 } } }, 0.0);
+  ASSERT_EQ(chosen.size(), 3u);
+  EXPECT_EQ(chosen[0][0], 100.0);
+  EXPECT_EQ(chosen[1][0], 50.0);
+  EXPECT_TRUE(chosen[2][0] == 25.0 || chosen[2][0] == 75.0);
+  // The minimum distance stops the selection instead of placing near-duplicates.
+  const std::vector<Vec3> two{ { { 0, 0, 0 } }, { { 0.1, 0, 0 } } };
+  EXPECT_EQ(morea::SpreadOutSubset(two, 2, { { { 50, 0, 0 } } }, 1.0).size(), 1u);
+}
+
+TEST(MeshPointPlacement, MaskBoundaryPointsOfACube)
+{
+  morea::Volume<std::uint8_t> mask({ { 5, 5, 5 } }, { { 1, 1, 1 } }, { { 0, 0, 0 } });
+  for (std::size_t k = 1; k < 4; ++k)
+    for (std::size_t j = 1; j < 4; ++j)
+      for (std::size_t i = 1; i < 4; ++i)
+        mask(i, j, k) = 1;
+  EXPECT_EQ(morea::MaskBoundaryPoints(mask).size(), 26u); // 27 voxels minus the centre
+}
+
+TEST(Tetrahedralization, DelaunayOfACubeTilesIt)
+{
+  morea::MeshDomain d;
+  d.upper = { { 2, 3, 4 } };
+  auto points = morea::DomainCorners(d);
+  points.push_back({ { 1, 1.5, 2 } });
+  const auto result = morea::Tetrahedralize(points);
+  EXPECT_EQ(result.steinerPoints, 0u);
+  double volume = 0.0;
+  for (const auto & t : result.tetrahedra)
+  {
+    const double v = morea::SignedVolume(t, result.points);
+    EXPECT_GT(v, 0.0);
+    volume += v;
+  }
+  EXPECT_NEAR(volume, 24.0, 1e-9);
+  EXPECT_THROW(morea::Tetrahedralize({ points[0], points[1], points[2] }), morea::Error);
+  EXPECT_THROW(morea::Tetrahedralize(points, { { { 0, 1, 99 } } }), morea::Error);
+}
+
+TEST(StructureSurface, SphereSurfaceIsClosedAndDecimated)
+{
+  morea::Volume<std::uint8_t> mask({ { 40, 40, 40 } }, { { 1, 1, 1 } }, { { -20, -20, -20 } });
+  for (std::size_t k = 0; k < 40; ++k)
+    for (std::size_t j = 0; j < 40; ++j)
+      for (std::size_t i = 0; i < 40; ++i)
+        mask(i, j, k) = Distance(mask.PointAt(i, j, k), { { 0, 0, 0 } }) <= 12.0;
+  const auto surface = morea::ExtractStructureSurface(mask, 150);
+  EXPECT_GT(surface.vertices.size(), 100u);
+  EXPECT_LT(surface.vertices.size(), 200u);
+  // Closed 2-manifold: every edge is shared by exactly two triangles.
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> edgeUse;
+  for (const auto & t : surface.triangles)
+    for (int e = 0; e < 3; ++e)
+    {
+      const auto a = t[e], b = t[(e + 1) % 3];
+      ++edgeUse[{ std::min(a, b), std::max(a, b) }];
+    }
+  for (const auto & [edge, uses] : edgeUse)
+    EXPECT_EQ(uses, 2);
+  EXPECT_EQ(surface.vertices.size() + surface.triangles.size() - edgeUse.size(), 2u); // Euler: sphere
+  for (const Vec3 & v : surface.vertices)
+    EXPECT_NEAR(Distance(v, { { 0, 0, 0 } }), 12.0, 1.5);
+  EXPECT_TRUE(morea::ExtractStructureSurface(mask.Like<std::uint8_t>(0), 100).triangles.empty());
+}
+
+TEST(MeshGenerator, OptionsFollowTheMethodName)
+{
+  morea::ParameterSet p;
+  auto                o = morea::MeshGeneratorOptions::FromParameters(p);
+  EXPECT_TRUE(o.useContourPoints);
+  EXPECT_DOUBLE_EQ(o.randomFraction, 0.10);
+  EXPECT_EQ(o.surfaceStructures, (std::vector<std::string>{ "bladder" }));
+  p.SetFromString("morea_mesh_generation_method", "annotation-group-random-20");
+  o = morea::MeshGeneratorOptions::FromParameters(p);
+  EXPECT_DOUBLE_EQ(o.randomFraction, 0.20);
+  EXPECT_TRUE(o.surfaceStructures.empty());
+  p.SetFromString("morea_mesh_generation_method", "random");
+  EXPECT_FALSE(morea::MeshGeneratorOptions::FromParameters(p).useContourPoints);
+  for (const char * bad : { "grid", "annotation-group-random-bladder-x", "annotation-group-random-200" })
+  {
+    p.SetFromString("morea_mesh_generation_method", bad);
+    EXPECT_THROW(morea::MeshGeneratorOptions::FromParameters(p), morea::Error) << bad;
+  }
+  p.SetFromString("morea_mesh_generation_method", "random");
+  p.SetFromString("morea_mesh_structure_shares", "bladder=2, bones");
+  EXPECT_THROW(morea::MeshGeneratorOptions::FromParameters(p), morea::Error);
+}
+
+TEST(MeshGenerator, PhantomMeshWithBladderSurface)
+{
+  const auto & pm = morea_test::PhantomMesh600();
+  const auto & mesh = pm.mesh;
+  const auto & r = pm.report;
+  for (const auto & note : r.notes)
+    ADD_FAILURE() << note;
+  EXPECT_EQ(mesh.NumberOfPoints(), 600u + r.steinerPoints);
+  EXPECT_EQ(r.corners + r.boundaryPoints + r.randomPoints + r.refinementPoints + r.contourPoints + r.surfacePoints, 600u);
+  EXPECT_GT(r.surfacePoints, 50u);
+  EXPECT_GT(r.contourPoints, 300u);
+  EXPECT_EQ(r.randomPoints + r.refinementPoints + r.boundaryPoints, 60u);
+  EXPECT_GT(r.refinementPoints, 0u);
+
+  // Positively oriented tetrahedra that tile the domain.
+  double volume = 0.0;
+  for (const auto & t : mesh.tetrahedra)
+  {
+    const double v = morea::SignedVolume(t, mesh.points);
+    ASSERT_GT(v, 0.0);
+    volume += v;
+  }
+  const Vec3 e = pm.domain.Extent();
+  EXPECT_NEAR(volume, e[0] * e[1] * e[2], 1e-6 * e[0] * e[1] * e[2]);
+
+  // Every constraining triangle is a face of the mesh.
+  if (r.steinerPoints == 0)
+  {
+    std::set<std::array<std::uint32_t, 3>> faces;
+    for (const auto & t : mesh.tetrahedra)
+      for (int skip = 0; skip < 4; ++skip)
+      {
+        std::array<std::uint32_t, 3> f{};
+        for (int v = 0, n = 0; v < 4; ++v)
+          if (v != skip)
+            f[n++] = t[v];
+        std::sort(f.begin(), f.end());
+        faces.insert(f);
+      }
+    ASSERT_FALSE(mesh.constrainedFaces.empty());
+    for (auto f : mesh.constrainedFaces)
+    {
+      std::sort(f.begin(), f.end());
+      EXPECT_TRUE(faces.count(f)) << "constraint triangle is not a mesh face";
+    }
+  }
+  // Pins: exactly the corners are fixed; boundary points are on their faces.
+  std::size_t fixed = 0;
+  for (std::size_t i = 0; i < mesh.NumberOfPoints(); ++i)
+  {
+    const auto & pin = mesh.pins[i];
+    fixed += (pin[0] != 0 && pin[1] != 0 && pin[2] != 0);
+    EXPECT_EQ(morea::ProjectToDomain(mesh.points[i], pin, pm.domain), mesh.points[i]);
+  }
+  EXPECT_EQ(fixed, 8u);
+
+  std::cout << "phantom mesh: " << mesh.NumberOfPoints() << " points (" << r.surfacePoints << " surface, "
+            << r.contourPoints << " contour, " << r.randomPoints << " random, " << r.refinementPoints
+            << " refinement, " << r.boundaryPoints << " on faces, " << r.steinerPoints << " Steiner), "
+            << mesh.NumberOfTetrahedra() << " tetrahedra (" << r.slivers << " of quality < 0.05, worst "
+            << r.worstQuality << "); placement "
+            << r.secondsPlacement << " s, surfaces " << r.secondsSurfaces << " s, TetGen "
+            << r.secondsTetrahedralization << " s\n";
+}
+
+TEST(MeshGenerator, SameSeedSameMesh)
+{
+  const auto &                      pm = morea_test::PhantomMesh600();
+  std::vector<morea::MeshStructure> structures;
+  for (std::size_t s = 1; s < pm.names.size(); ++s)
+    structures.push_back({ pm.names[s], morea::MaskBoundaryPoints(pm.phantomCase.movingMasks[s]),
+                           &pm.phantomCase.movingMasks[s] });
+  morea::MeshGeneratorOptions options;
+  options.seed = 7;
+  const auto again = morea::GenerateMesh(pm.domain, structures, options);
+  EXPECT_EQ(again.points, pm.mesh.points);
+  EXPECT_EQ(again.tetrahedra, pm.mesh.tetrahedra);
+  options.seed = 8;
+  EXPECT_NE(morea::GenerateMesh(pm.domain, structures, options).points, pm.mesh.points);
+}
+} // namespace
