@@ -1,7 +1,11 @@
 // Preprocessing on the real patient pairs in ../shared/data (skipped when absent).
 #include "itkMOREAImageIO.h"
+#include "itkMeshModel.h"
 #include "itkPreprocessing.h"
 #include "itkRegistrationEvaluation.h"
+#include "morea/FoldConstraint.h"
+#include "morea/InitialPopulation.h"
+#include "morea/ParameterSet.h"
 
 #include <gtest/gtest.h>
 
@@ -40,6 +44,29 @@ TEST(RealData, LungPairRigidPreAlignmentOnLungMasksBringsTreUnderFiveMillimetres
   EXPECT_EQ(after.landmarksOutside, 0u);
   EXPECT_LT(after.landmarks.mean, 5.0);
   EXPECT_GT(after.structures.at(0).dice, 0.85);
+
+  // The 600-point mesh model with the lung surface as a constraint.
+  ::morea::ParameterSet parameters;
+  parameters.SetFromString("morea_mesh_surface_structures", "lungs");
+  const MeshModel model = BuildMeshModel(result.problem, parameters);
+  const auto &    g = model.report.generation;
+  for (const auto & note : g.notes)
+    EXPECT_EQ(note.find("instead"), std::string::npos) << note;
+  EXPECT_EQ(model.base.NumberOfPoints(), 600u + g.steinerPoints);
+  EXPECT_GT(g.surfacePoints, 300u);
+  EXPECT_FALSE(model.base.constrainedFaces.empty());
+  EXPECT_GE(model.report.parallelGroups, 2u);
+  const ::morea::FoldConstraint constraint(model.topology, model.base.points);
+  for (const auto & s : ::morea::GenerateInitialPopulation(model.base, constraint, 20, 1))
+    EXPECT_TRUE(constraint.Evaluate(s).Feasible());
+  std::cout << "lung mesh: " << model.base.NumberOfPoints() << " points (" << g.surfacePoints << " on the lung surface, "
+            << g.surfaceTriangles << " constraining triangles, " << g.steinerPoints << " Steiner), "
+            << model.base.NumberOfTetrahedra() << " tetrahedra (" << g.slivers << " slivers), "
+            << model.report.fosElements << " FOS elements, " << model.report.parallelGroups
+            << " parallel groups; seconds: contour points " << model.report.secondsContourPoints << ", surface "
+            << g.secondsSurfaces << ", placement " << g.secondsPlacement << ", TetGen and sliver removal "
+            << g.secondsTetrahedralization << ", parallel structure " << model.report.secondsParallelStructure
+            << ", elasticity " << model.report.secondsElasticity << "\n";
 }
 
 TEST(RealData, AbdomenPairLoadsFromLabelMapsAndCropsToTheStomach)

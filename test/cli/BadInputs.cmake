@@ -373,6 +373,19 @@ evaluate_outputs(o badmargin)
 expect_failure("non-numeric border margin" USAGE OUTPUTS ${o}
   FRAGMENTS "border-margin"
   ARGS evaluate --fixed "${fixed}" --moving "${moving}" --border-margin wide -o "${WORK}/badmargin.json")
+# --- mesh ---------------------------------------------------------------------------------------------
+set(o "${WORK}/mesh-out")
+expect_failure("mesh: unknown generation method" OUTPUTS ${o} FRAGMENTS "morea_mesh_generation_method" "grid"
+  ARGS mesh --fixed "${fixed}" --moving "${moving}" ${blob} --set morea_mesh_generation_method=grid -o "${o}")
+expect_failure("mesh: malformed structure shares" OUTPUTS ${o} FRAGMENTS "morea_mesh_structure_shares"
+  ARGS mesh --fixed "${fixed}" --moving "${moving}" ${blob} --set "morea_mesh_structure_shares=blob" -o "${o}")
+expect_failure("mesh: negative elasticity factor" OUTPUTS ${o} FRAGMENTS "morea_elasticity_factors" "positive"
+  ARGS mesh --fixed "${fixed}" --moving "${moving}" ${blob} --set "morea_elasticity_factors=blob=-2" -o "${o}")
+expect_failure("mesh: unknown guidance structure" OUTPUTS ${o} FRAGMENTS "liver"
+  ARGS mesh --fixed "${fixed}" --moving "${moving}" ${blob} --set problem_guidance_selection=liver -o "${o}")
+expect_failure("mesh: too few points" USAGE OUTPUTS ${o} FRAGMENTS "morea_mesh_num_points"
+  ARGS mesh --fixed "${fixed}" --moving "${moving}" ${blob} --set morea_mesh_num_points=4 -o "${o}")
+
 
 get_property(failed GLOBAL PROPERTY MOREA_FAILED_CASES)
 if(failed)
@@ -381,3 +394,4 @@ if(failed)
   message(FATAL_ERROR "cli.bad_inputs: ${n} case(s) failed:\n  ${failed}")
 endif()
 message(STATUS "cli.bad_inputs: all checks passed")
+

@@ -131,6 +131,31 @@ if(leftovers)
   message(FATAL_ERROR "preprocess: temporary files were left behind: ${leftovers}")
 endif()
 
+# --- mesh model of the preprocessed problem ---------------------------------------------------------
+set(meshdir "${WORK}/mesh")
+morea_ok("mesh" mesh --problem "${pre}" --set morea_mesh_num_points=200 --samples 1 -o "${meshdir}")
+expect_files("mesh"
+  "${meshdir}/mesh.json"
+  "${meshdir}/mesh_moving.vtu"
+  "${meshdir}/mesh_fixed.vtu"
+  "${meshdir}/initial_1_mesh_moving.vtu"
+  "${meshdir}/initial_1_fixed_to_moving.nii.gz"
+  "${meshdir}/initial_1_moving_to_fixed.nii.gz")
+file(READ "${meshdir}/mesh.json" mesh_json)
+json_number(mesh_points "mesh.json" "${mesh_json}" points)
+json_number(mesh_steiner "mesh.json" "${mesh_json}" points_by_origin steiner)
+json_number(mesh_surface "mesh.json" "${mesh_json}" points_by_origin surface)
+json_number(mesh_groups "mesh.json" "${mesh_json}" parallel_groups)
+math(EXPR mesh_expected "200 + ${mesh_steiner}")
+if(NOT mesh_points EQUAL mesh_expected OR mesh_surface LESS 10 OR mesh_groups LESS 2)
+  message(FATAL_ERROR "mesh.json: ${mesh_points} points (${mesh_surface} on the bladder surface), "
+                      "${mesh_groups} parallel groups:\n${mesh_json}")
+endif()
+file(READ "${meshdir}/mesh_fixed.vtu" vtu LIMIT 400)
+if(NOT vtu MATCHES "UnstructuredGrid")
+  message(FATAL_ERROR "mesh_fixed.vtu is not a VTK unstructured grid:\n${vtu}")
+endif()
+
 # --- evaluate the identity baseline on the preprocessed problem -------------------------------------
 morea_ok("evaluate baseline" evaluate --problem "${pre}" -o "${WORK}/scores.json" --render "${WORK}/render")
 expect_files("evaluate baseline"
