@@ -1,0 +1,25 @@
+// MultiObjectiveRegistration core: the deformation magnitude objective (SPEC 5),
+// per tetrahedron so that partial evaluation is exact.
+#ifndef morea_MagnitudeObjective_h
+#define morea_MagnitudeObjective_h
+
+#include "morea/TetrahedralMesh.h"
+
+#include <vector>
+
+namespace morea
+{
+/** c_t times the sum over the tetrahedron's 10 edges (its 6 edges and the 4
+ *  spokes from its centroid to its corners) of (|e_source| - |e_target|)^2.
+ *  The objective is the sum of these over all tetrahedra divided by 10 |T|. */
+double
+TetrahedronMagnitude(const Tetrahedron & t, const std::vector<Vec3> & source, const std::vector<Vec3> & target,
+                     double elasticity);
+
+/** The whole objective: sum over t of TetrahedronMagnitude / (10 |T|).
+ *  `elasticity` holds one factor per tetrahedron (empty: all 1). */
+double
+MagnitudeObjective(const MeshTopology & topology, const DualMesh & solution, const std::vector<double> & elasticity);
+} // namespace morea
+
+#endif
