@@ -58,7 +58,8 @@ ApplyRadialBasisDeformation(std::vector<Vec3> & points, const TetrahedralMesh & 
     kernel.inverseTwoSigmaSquared = 1.0 / (2.0 * sigma * sigma);
     kernels.push_back(kernel);
   }
-  const std::size_t rounds = 1 + static_cast<std::size_t>(random.Uniform() * static_cast<double>(options.maxRounds));
+  const std::size_t rounds =
+    std::min(options.maxRounds, 1 + static_cast<std::size_t>(random.Uniform() * static_cast<double>(options.maxRounds)));
   const double      step = options.roundStep * options.noiseFactor * minExtent;
   if (!(step > 0.0) || kernels.empty())
     return 0;
@@ -69,7 +70,7 @@ ApplyRadialBasisDeformation(std::vector<Vec3> & points, const TetrahedralMesh & 
   std::size_t       applied = 0;
   std::vector<Vec3> trial(points.size());
   double            roundStep = step;
-  for (std::size_t r = 0, refusals = 0; r < std::min(rounds, options.maxRounds) && refusals < 4; ++r)
+  for (std::size_t r = 0, refusals = 0; r < rounds && refusals < 4; ++r)
   {
     double largest = 0.0;
     for (std::size_t i = 0; i < points.size(); ++i)

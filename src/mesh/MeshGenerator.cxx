@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <numeric>
 
 namespace morea
@@ -82,6 +83,22 @@ Circumcentre(const Vec3 & a, const Vec3 & b, const Vec3 & c, const Vec3 & d, Vec
   return true;
 }
 
+/** Squared length of the longest edge of a tetrahedron. */
+double
+LongestSquaredEdge(const Vec3 * const (&p)[4])
+{
+  double longest = 0.0;
+  for (int i = 0; i < 4; ++i)
+    for (int j = i + 1; j < 4; ++j)
+    {
+      double d2 = 0.0;
+      for (int k = 0; k < 3; ++k)
+        d2 += ((*p[i])[k] - (*p[j])[k]) * ((*p[i])[k] - (*p[j])[k]);
+      longest = std::max(longest, d2);
+    }
+  return longest;
+}
+
 /** Up to `count` new points at the circumcentres (or, when those lie outside
  *  the domain, the centroids) of the worst-shaped tetrahedra of quality below
  *  0.2, none closer than a third of the tetrahedron's size to any point. */
@@ -109,16 +126,7 @@ RefinementPoints(const TetrahedralizationResult & tet, const std::vector<Vec3> &
     if (!Circumcentre(*p[0], *p[1], *p[2], *p[3], centre) || !InsideShrunk(centre, domain, margin))
       for (int k = 0; k < 3; ++k)
         centre[k] = ((*p[0])[k] + (*p[1])[k] + (*p[2])[k] + (*p[3])[k]) / 4.0;
-    double longest = 0.0;
-    for (int i = 0; i < 4; ++i)
-      for (int j = i + 1; j < 4; ++j)
-      {
-        double d2 = 0.0;
-        for (int k = 0; k < 3; ++k)
-          d2 += ((*p[i])[k] - (*p[j])[k]) * ((*p[i])[k] - (*p[j])[k]);
-        longest = std::max(longest, d2);
-      }
-    const double minimum = longest / 9.0; // (longest edge / 3)^2
+    const double minimum = LongestSquaredEdge(p) / 9.0; // (longest edge / 3)^2
     const auto   tooClose = [&](const std::vector<Vec3> & set) {
       return std::any_of(set.begin(), set.end(), [&](const Vec3 & x) {
         double d2 = 0.0;
@@ -177,6 +185,83 @@ struct PointSet
     }
   }
 };
+
+/** How far the tetrahedra fall short of the sliver quality threshold, summed. */
+double
+SliverShortfall(const TetrahedralizationResult & r)
+{
+  double sum = 0.0;
+  for (const auto & v : r.tetrahedra)
+    sum += std::max(0.0, kSliverQuality - TetrahedronQuality(r.points[v[0]], r.points[v[1]], r.points[v[2]], r.points[v[3]]));
+  return sum;
+}
+
+/** Sliver removal: Delaunay meshes of points on smooth surfaces have flat
+ *  tetrahedra wherever four points are nearly cospherical. Nudging one free
+ *  vertex of each (contour points by at most a small distance, so they stay
+ *  on their contour) and re-meshing removes most; a pass is kept only when
+ *  it lowers the total shortfall below the quality threshold. */
+void
+RemoveSlivers(PointSet & set, TetrahedralizationResult & tet,
+              const std::function<TetrahedralizationResult()> & tetrahedralize, RandomGenerator & random,
+              const MeshDomain & domain, double margin, double contourJitter)
+{
+  double currentBadness = SliverShortfall(tet);
+  for (std::size_t pass = 0; pass < 60 && currentBadness > 0.0; ++pass)
+  {
+    const std::vector<Vec3> saved = set.points;
+    std::vector<bool>       moved(set.points.size(), false);
+    for (const auto & v : tet.tetrahedra)
+    {
+      const Vec3 * p[4] = { &tet.points[v[0]], &tet.points[v[1]], &tet.points[v[2]], &tet.points[v[3]] };
+      if (TetrahedronQuality(*p[0], *p[1], *p[2], *p[3]) >= kSliverQuality)
+        continue;
+      // The freest vertex: random or refinement, then face, then contour points.
+      int best = -1, bestRank = 99;
+      for (int k = 0; k < 4; ++k)
+      {
+        const std::uint32_t i = v[k];
+        if (i >= set.points.size() || moved[i])
+          continue;
+        const PointOrigin o = set.origins[i];
+        const int rank = (o == PointOrigin::Random || o == PointOrigin::Refinement) ? 0
+                         : o == PointOrigin::BoundaryFace                          ? 1
+                         : o == PointOrigin::Contour                               ? 2
+                                                                                   : 99;
+        if (rank < bestRank)
+        {
+          bestRank = rank;
+          best = k;
+        }
+      }
+      if (best < 0 || bestRank == 99)
+        continue;
+      const std::uint32_t i = v[best];
+      const double longest = std::sqrt(LongestSquaredEdge(p));
+      const double sigma = bestRank == 2 ? std::min(0.1 * longest, contourJitter) : 0.1 * longest;
+      Vec3         q = set.points[i];
+      for (int k = 0; k < 3; ++k)
+        q[k] += sigma * random.Normal();
+      const bool onFace = set.origins[i] == PointOrigin::BoundaryFace;
+      for (int k = 0; k < 3; ++k)
+        if (!onFace || set.pins[i][k] == 0)
+          q[k] = std::clamp(q[k], domain.lower[k] + margin, domain.upper[k] - margin);
+      set.points[i] = ProjectToDomain(q, set.pins[i], domain);
+      moved[i] = true;
+    }
+    TetrahedralizationResult trial = tetrahedralize();
+    const double             trialBadness = SliverShortfall(trial);
+    if (trialBadness < currentBadness)
+    {
+      tet = std::move(trial);
+      currentBadness = trialBadness;
+    }
+    else
+    {
+      set.points = saved;
+    }
+  }
+}
 } // namespace
 
 MeshGeneratorOptions
@@ -434,80 +519,7 @@ GenerateMesh(const MeshDomain & domain, const std::vector<MeshStructure> & struc
     }
     tet = tetrahedralize();
   }
-  // Sliver removal: Delaunay meshes of points on smooth surfaces have flat
-  // tetrahedra wherever four points are nearly cospherical. Nudging one free
-  // vertex of each (contour points by at most a small distance, so they stay
-  // on their contour) and re-meshing removes most; a pass is kept only when
-  // it lowers the total shortfall below the quality threshold.
-  const auto badness = [&](const TetrahedralizationResult & r) {
-    double sum = 0.0;
-    for (const auto & v : r.tetrahedra)
-      sum += std::max(0.0, kSliverQuality - TetrahedronQuality(r.points[v[0]], r.points[v[1]], r.points[v[2]], r.points[v[3]]));
-    return sum;
-  };
-  double currentBadness = badness(tet);
-  for (std::size_t pass = 0; pass < 60 && currentBadness > 0.0; ++pass)
-  {
-    const std::vector<Vec3> saved = set.points;
-    std::vector<bool>       moved(set.points.size(), false);
-    for (const auto & v : tet.tetrahedra)
-    {
-      const Vec3 * p[4] = { &tet.points[v[0]], &tet.points[v[1]], &tet.points[v[2]], &tet.points[v[3]] };
-      if (TetrahedronQuality(*p[0], *p[1], *p[2], *p[3]) >= kSliverQuality)
-        continue;
-      // The freest vertex: random or refinement, then face, then contour points.
-      int best = -1, bestRank = 99;
-      for (int k = 0; k < 4; ++k)
-      {
-        const std::uint32_t i = v[k];
-        if (i >= set.points.size() || moved[i])
-          continue;
-        const PointOrigin o = set.origins[i];
-        const int rank = (o == PointOrigin::Random || o == PointOrigin::Refinement) ? 0
-                         : o == PointOrigin::BoundaryFace                          ? 1
-                         : o == PointOrigin::Contour                               ? 2
-                                                                                   : 99;
-        if (rank < bestRank)
-        {
-          bestRank = rank;
-          best = k;
-        }
-      }
-      if (best < 0 || bestRank == 99)
-        continue;
-      const std::uint32_t i = v[best];
-      double longest = 0.0;
-      for (int a = 0; a < 4; ++a)
-        for (int b = a + 1; b < 4; ++b)
-        {
-          double d2 = 0.0;
-          for (int k = 0; k < 3; ++k)
-            d2 += ((*p[a])[k] - (*p[b])[k]) * ((*p[a])[k] - (*p[b])[k]);
-          longest = std::max(longest, std::sqrt(d2));
-        }
-      const double sigma = bestRank == 2 ? std::min(0.1 * longest, contourJitter) : 0.1 * longest;
-      Vec3         q = set.points[i];
-      for (int k = 0; k < 3; ++k)
-        q[k] += sigma * random.Normal();
-      const bool onFace = set.origins[i] == PointOrigin::BoundaryFace;
-      for (int k = 0; k < 3; ++k)
-        if (!onFace || set.pins[i][k] == 0)
-          q[k] = std::clamp(q[k], domain.lower[k] + margin, domain.upper[k] - margin);
-      set.points[i] = ProjectToDomain(q, set.pins[i], domain);
-      moved[i] = true;
-    }
-    TetrahedralizationResult trial = tetrahedralize();
-    const double             trialBadness = badness(trial);
-    if (trialBadness < currentBadness)
-    {
-      tet = std::move(trial);
-      currentBadness = trialBadness;
-    }
-    else
-    {
-      set.points = saved;
-    }
-  }
+  RemoveSlivers(set, tet, tetrahedralize, random, domain, margin, contourJitter);
   report.secondsTetrahedralization = SecondsSince(start);
 
   TetrahedralMesh mesh;
