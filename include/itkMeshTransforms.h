@@ -13,6 +13,7 @@
 
 #include "itkDisplacementFieldTransform.h"
 #include "itkMOREATypes.h"
+#include "itkRigidPreAlignment.h"
 #include "morea/MeshRasterizer.h"
 #include "morea/TetrahedralMesh.h"
 #include "morea/VtuWriter.h"
@@ -108,6 +109,16 @@ struct MeshFields
 MeshFields
 RasterizeSolution(const ::morea::MeshTopology & topology, const ::morea::DualMesh & solution,
                   const ImageBase<Dimension> * fixedGrid, const ImageBase<Dimension> * movingGrid);
+
+/** Writes a solution's two transforms for the original images as ITK
+ *  transform files (.h5 or .tfm; antsApplyTransforms, 3D Slicer and SimpleITK
+ *  read them): composites of the rigid pre-alignment `rigid` (preprocessed
+ *  frame -> original moving image; null: none) and the displacement fields,
+ *  fixed -> moving as rigid(x + u(x)) and moving -> fixed as
+ *  y' + v(y') with y' = rigid^-1(y). Atomic; throws on failure. */
+void
+WriteSolutionTransforms(const MeshFields & fields, const RigidTransformType * rigid,
+                        const std::string & fixedToMovingPath, const std::string & movingToFixedPath);
 
 /** Writes a mesh given in `frame` coordinates as a .vtu in physical space
  *  (ParaView, 3D Slicer); atomic. Tetrahedra are reordered to stay positively

@@ -44,6 +44,10 @@ public:
   double
   TetrahedronViolation(std::size_t t, const std::vector<Vec3> & points, bool & folded) const;
 
+  /** The same for a tetrahedron given by its corners. */
+  double
+  TetrahedronViolation(std::size_t t, const Vec3 & a, const Vec3 & b, const Vec3 & c, const Vec3 & d,
+                       bool & folded) const;
   /** All tetrahedra of one mesh; fills `perTetrahedron` when given. */
   FoldViolation
   Evaluate(const std::vector<Vec3> & points, std::vector<double> * perTetrahedron = nullptr) const;

@@ -5,6 +5,7 @@
 
 #include "morea/TetrahedralMesh.h"
 
+#include <array>
 #include <vector>
 
 namespace morea
@@ -16,6 +17,9 @@ double
 TetrahedronMagnitude(const Tetrahedron & t, const std::vector<Vec3> & source, const std::vector<Vec3> & target,
                      double elasticity);
 
+/** The same for corners given directly (source[i] and target[i] are one point). */
+double
+TetrahedronMagnitude(const std::array<Vec3, 4> & source, const std::array<Vec3, 4> & target, double elasticity);
 /** The whole objective: sum over t of TetrahedronMagnitude / (10 |T|).
  *  `elasticity` holds one factor per tetrahedron (empty: all 1). */
 double

@@ -43,6 +43,15 @@ RepairResult
 RepairFolds(std::vector<Vec3> & points, const TetrahedralMesh & base, const FoldConstraint & constraint,
             RandomGenerator & random, const RepairOptions & options = {});
 
+/** The same, moving only the points in `movable` (null: all) and looking only
+ *  at the tetrahedra in `scope` (null: all; it must hold every tetrahedron of
+ *  the movable points). A variation step repairs only the points it moved
+ *  within its dependent tetrahedra, so that candidates of one parallel group
+ *  stay independent; before/after then count the scope only. */
+RepairResult
+RepairPoints(std::vector<Vec3> & points, const std::vector<std::uint32_t> * movable,
+             const std::vector<std::uint32_t> * scope, const TetrahedralMesh & base, const FoldConstraint & constraint,
+             RandomGenerator & random, const RepairOptions & options = {});
 /** Both meshes of a solution. */
 RepairResult
 RepairFolds(DualMesh & solution, const TetrahedralMesh & base, const FoldConstraint & constraint,

@@ -84,6 +84,8 @@ AddEvaluateCommand(CLI::App & app);
 void
 AddMeshCommand(CLI::App & app);
 void
+AddRegisterCommand(CLI::App & app);
+void
 AddDemoCommand(CLI::App & app);
 void
 AddInfoCommand(CLI::App & app);

@@ -16,6 +16,7 @@ main(int argc, char ** argv)
   morea::cli::AddPreprocessCommand(app);
   morea::cli::AddEvaluateCommand(app);
   morea::cli::AddMeshCommand(app);
+  morea::cli::AddRegisterCommand(app);
   morea::cli::AddDemoCommand(app);
   morea::cli::AddInfoCommand(app);
   try

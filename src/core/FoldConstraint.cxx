@@ -30,6 +30,15 @@ FoldConstraint::TetrahedronViolation(std::size_t t, const std::vector<Vec3> & po
   return folded ? std::abs(v) : 0.0;
 }
 
+double
+FoldConstraint::TetrahedronViolation(std::size_t t, const Vec3 & a, const Vec3 & b, const Vec3 & c, const Vec3 & d,
+                                     bool & folded) const
+{
+  const double v = SignedVolume(a, b, c, d);
+  folded = !(v * m_ReferenceSigns[t] > 0.0);
+  return folded ? std::abs(v) : 0.0;
+}
+
 FoldViolation
 FoldConstraint::Evaluate(const std::vector<Vec3> & points, std::vector<double> * perTetrahedron) const
 {

@@ -15,34 +15,41 @@ Length(const Vec3 & a, const Vec3 & b)
 }
 
 Vec3
-Centroid(const Tetrahedron & t, const std::vector<Vec3> & p)
+Centroid(const std::array<Vec3, 4> & p)
 {
   Vec3 c{ { 0.0, 0.0, 0.0 } };
-  for (std::uint32_t v : t)
+  for (const Vec3 & v : p)
     for (int a = 0; a < 3; ++a)
-      c[a] += 0.25 * p[v][a];
+      c[a] += 0.25 * v[a];
   return c;
 }
 } // namespace
 
 double
-TetrahedronMagnitude(const Tetrahedron & t, const std::vector<Vec3> & source, const std::vector<Vec3> & target,
-                     double elasticity)
+TetrahedronMagnitude(const std::array<Vec3, 4> & source, const std::array<Vec3, 4> & target, double elasticity)
 {
   double sum = 0.0;
   for (int i = 0; i < 4; ++i)
     for (int j = i + 1; j < 4; ++j)
     {
-      const double d = Length(source[t[i]], source[t[j]]) - Length(target[t[i]], target[t[j]]);
+      const double d = Length(source[i], source[j]) - Length(target[i], target[j]);
       sum += d * d;
     }
-  const Vec3 cs = Centroid(t, source), ct = Centroid(t, target);
+  const Vec3 cs = Centroid(source), ct = Centroid(target);
   for (int i = 0; i < 4; ++i)
   {
-    const double d = Length(cs, source[t[i]]) - Length(ct, target[t[i]]);
+    const double d = Length(cs, source[i]) - Length(ct, target[i]);
     sum += d * d;
   }
   return elasticity * sum;
+}
+
+double
+TetrahedronMagnitude(const Tetrahedron & t, const std::vector<Vec3> & source, const std::vector<Vec3> & target,
+                     double elasticity)
+{
+  return TetrahedronMagnitude({ source[t[0]], source[t[1]], source[t[2]], source[t[3]] },
+                              { target[t[0]], target[t[1]], target[t[2]], target[t[3]] }, elasticity);
 }
 
 double

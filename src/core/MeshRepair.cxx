@@ -45,18 +45,46 @@ RepairResult
 RepairFolds(std::vector<Vec3> & points, const TetrahedralMesh & base, const FoldConstraint & constraint,
             RandomGenerator & random, const RepairOptions & options)
 {
+  return RepairPoints(points, nullptr, nullptr, base, constraint, random, options);
+}
+
+RepairResult
+RepairPoints(std::vector<Vec3> & points, const std::vector<std::uint32_t> * movable,
+             const std::vector<std::uint32_t> * scope, const TetrahedralMesh & base, const FoldConstraint & constraint,
+             RandomGenerator & random, const RepairOptions & options)
+{
   const MeshTopology & topology = constraint.Topology();
-  RepairResult         result;
-  result.before = constraint.Evaluate(points);
+  auto evaluate = [&] { return scope ? constraint.Partial(points, *scope) : constraint.Evaluate(points); };
+  auto foldedTetrahedra = [&] {
+    if (!scope)
+      return constraint.FoldedTetrahedra(points);
+    std::vector<std::uint32_t> folded;
+    for (std::uint32_t t : *scope)
+    {
+      bool f = false;
+      constraint.TetrahedronViolation(t, points, f);
+      if (f)
+        folded.push_back(t);
+    }
+    return folded;
+  };
+  RepairResult result;
+  result.before = evaluate();
   result.after = result.before;
   for (std::size_t round = 0; round < options.maxRounds && !result.after.Feasible(); ++round)
   {
     std::vector<std::uint32_t> candidates;
-    for (std::uint32_t t : constraint.FoldedTetrahedra(points))
+    for (std::uint32_t t : foldedTetrahedra())
       for (std::uint32_t v : topology.Tetrahedra()[t])
         candidates.push_back(v);
     std::sort(candidates.begin(), candidates.end());
     candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+    if (movable)
+      candidates.erase(std::remove_if(candidates.begin(), candidates.end(),
+                                      [&](std::uint32_t p) {
+                                        return std::find(movable->begin(), movable->end(), p) == movable->end();
+                                      }),
+                       candidates.end());
 
     bool moved = false;
     for (std::uint32_t p : candidates)
@@ -93,7 +121,7 @@ RepairFolds(std::vector<Vec3> & points, const TetrahedralMesh & base, const Fold
         ++result.movedPoints;
       }
     }
-    result.after = constraint.Evaluate(points);
+    result.after = evaluate();
     if (!moved)
       break;
   }

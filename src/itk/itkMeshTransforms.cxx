@@ -1,4 +1,6 @@
 #include "itkMeshTransforms.h"
+#include "itkCompositeTransform.h"
+#include "itkTransformFileWriter.h"
 
 #include "itkMOREAImageIO.h"
 #include "itkPhantomImages.h"
@@ -7,6 +9,7 @@
 #include "vnl/algo/vnl_determinant.h"
 
 #include <cmath>
+#include <cstdio>
 #include <utility>
 
 namespace itk
@@ -293,6 +296,50 @@ WriteMeshVtu(const std::string & path, const ::morea::MeshTopology & topology,
   catch (const ::morea::Error & e)
   {
     itkGenericExceptionMacro(<< e.what());
+  }
+}
+
+void
+WriteSolutionTransforms(const MeshFields & fields, const RigidTransformType * rigid,
+                        const std::string & fixedToMovingPath, const std::string & movingToFixedPath)
+{
+  using CompositeType = CompositeTransform<double, Dimension>;
+  // CompositeTransform applies the transform added last first.
+  auto forward = CompositeType::New();
+  auto backward = CompositeType::New();
+  // Fresh transforms without inverse fields: the files hold one field each.
+  auto u = DisplacementFieldTransformType::New();
+  u->SetDisplacementField(fields.fixedToMoving);
+  auto v = DisplacementFieldTransformType::New();
+  v->SetDisplacementField(fields.movingToFixed);
+  if (rigid)
+    forward->AddTransform(const_cast<RigidTransformType *>(rigid));
+  forward->AddTransform(u);
+  backward->AddTransform(v);
+  if (rigid)
+  {
+    auto inverse = RigidTransformType::New();
+    if (!rigid->GetInverse(inverse))
+      itkGenericExceptionMacro("the rigid pre-alignment is not invertible");
+    backward->AddTransform(inverse);
+  }
+  for (const auto & [transform, path] : { std::make_pair(forward, fixedToMovingPath),
+                                          std::make_pair(backward, movingToFixedPath) })
+  {
+    const std::string tmp = TemporaryPathFor(path);
+    auto              writer = TransformFileWriterTemplate<double>::New();
+    writer->SetInput(transform);
+    writer->SetFileName(tmp);
+    try
+    {
+      writer->Update();
+    }
+    catch (const ExceptionObject & e)
+    {
+      std::remove(tmp.c_str());
+      itkGenericExceptionMacro("cannot write transform '" << path << "': " << e.GetDescription());
+    }
+    CommitFile(tmp, path);
   }
 }
 

@@ -1,0 +1,69 @@
+/*=========================================================================
+ *  MultiObjectiveRegistration: one MOREA run on a preprocessed problem.
+ *
+ *  Mesh model, objective data, initial population, MO-RV-GOMEA on the chosen
+ *  backend, with checkpoints; returns the approximation set. The template
+ *  filter (itkMultiObjectiveMeshRegistrationFilter.h) and the command line
+ *  both call this, so the heavy work is compiled once.
+ *=========================================================================*/
+#ifndef itkMeshRegistration_h
+#define itkMeshRegistration_h
+
+#include "itkMeshModel.h"
+#include "itkRegistrationProblem.h"
+#include "morea/MoRvGomea.h"
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace morea
+{
+class ParameterSet;
+}
+
+namespace itk
+{
+namespace morea
+{
+struct MeshRegistrationOptions
+{
+  /** Checkpoint file; empty: none. Written every `checkpointInterval`
+   *  generations and after the last one. */
+  std::string checkpointPath;
+  std::size_t checkpointInterval{ 0 };
+  /** Continue from `checkpointPath` when it exists. */
+  bool        resume{ false };
+  std::size_t threads{ 0 }; ///< CPU backend threads; 0: all
+  /** After each generation (also the resumed ones' replay is not called). May throw to abort. */
+  std::function<void(const ::morea::GenerationRecord &, std::size_t generations)> onGeneration;
+};
+
+/** One solution of the approximation set. */
+struct FrontSolution
+{
+  std::uint64_t       id{ 0 };
+  ::morea::Fitness    fitness;
+  ::morea::DualMesh   mesh;
+};
+
+struct MeshRegistrationResult
+{
+  MeshModel                              model;
+  std::vector<FrontSolution>             front; ///< the elitist archive, by ascending guidance
+  std::vector<::morea::GenerationRecord> history;
+  std::string                            backend;
+  std::size_t                            threads{ 0 };
+  std::size_t                            resumedAtGeneration{ 0 }; ///< 0 when started afresh
+  double                                 secondsModel{ 0.0 };
+  double                                 secondsOptimisation{ 0.0 };
+};
+
+/** Registers a preprocessed problem (both images on one grid). */
+MeshRegistrationResult
+RegisterMeshes(const RegistrationProblem & problem, const ::morea::ParameterSet & parameters,
+               const MeshRegistrationOptions & options = {});
+} // namespace morea
+} // namespace itk
+
+#endif

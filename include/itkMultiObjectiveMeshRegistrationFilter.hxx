@@ -1,0 +1,519 @@
+/*=========================================================================
+ *  MultiObjectiveRegistration: MOREA as an ITK process object.
+ *
+ *  Kept thin: input conversion and output wiring only; the run itself is the
+ *  non-template RunMultiObjectiveRegistration (compiled once in the library).
+ *=========================================================================*/
+#ifndef itkMultiObjectiveMeshRegistrationFilter_hxx
+#define itkMultiObjectiveMeshRegistrationFilter_hxx
+
+#include "itkCastImageFilter.h"
+#include "itkMultiObjectiveMeshRegistrationFilter.h"
+
+#include <algorithm>
+#include <exception>
+#include <type_traits>
+
+namespace itk
+{
+namespace morea
+{
+namespace detail
+{
+inline std::string
+FixedStructureInputName(const std::string & name)
+{
+  return "FixedStructure:" + name;
+}
+
+inline std::string
+MovingStructureInputName(const std::string & name)
+{
+  return "MovingStructure:" + name;
+}
+} // namespace detail
+} // namespace morea
+
+template <typename TFixedImage, typename TMovingImage>
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::MultiObjectiveMeshRegistrationFilter()
+{
+  Self::SetPrimaryInputName("Fixed");
+  Self::AddRequiredInputName("Moving", 1);
+  ProcessObject::SetNumberOfRequiredInputs(2);
+
+  // Optional named inputs.
+  Self::SetInput("FixedBodyMask", nullptr);
+  Self::SetInput("MovingBodyMask", nullptr);
+
+  // The approximation set and the rigid transform always exist; the chosen
+  // solutions' transforms are added by GenerateData.
+  ProcessObject::SetNumberOfRequiredOutputs(FirstSolutionOutput);
+  for (DataObjectPointerArraySizeType i = 0; i < FirstSolutionOutput; ++i)
+    this->SetNthOutput(i, this->MakeOutput(i));
+}
+
+template <typename TFixedImage, typename TMovingImage>
+void
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::SetFixedImage(const FixedImageType * image)
+{
+  if (image != this->GetFixedImage())
+  {
+    this->ProcessObject::SetNthInput(0, const_cast<FixedImageType *>(image));
+    this->Modified();
+  }
+}
+
+template <typename TFixedImage, typename TMovingImage>
+auto
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GetFixedImage() const -> const FixedImageType *
+{
+  return itkDynamicCastInDebugMode<const FixedImageType *>(this->ProcessObject::GetInput(0));
+}
+
+template <typename TFixedImage, typename TMovingImage>
+void
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::SetMovingImage(const MovingImageType * image)
+{
+  if (image != this->GetMovingImage())
+  {
+    this->ProcessObject::SetNthInput(1, const_cast<MovingImageType *>(image));
+    this->Modified();
+  }
+}
+
+template <typename TFixedImage, typename TMovingImage>
+auto
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GetMovingImage() const -> const MovingImageType *
+{
+  return itkDynamicCastInDebugMode<const MovingImageType *>(this->ProcessObject::GetInput(1));
+}
+
+template <typename TFixedImage, typename TMovingImage>
+void
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::AddStructure(const std::string & name,
+                                                                              const MaskType *    fixedMask,
+                                                                              const MaskType *    movingMask)
+{
+  if (name.empty())
+  {
+    itkExceptionMacro("AddStructure: a structure needs a name");
+  }
+  // Null sides are kept as null inputs, so that Update() names the structure
+  // in its error rather than the call silently dropping it.
+  this->ProcessObject::SetInput(morea::detail::FixedStructureInputName(name), const_cast<MaskType *>(fixedMask));
+  this->ProcessObject::SetInput(morea::detail::MovingStructureInputName(name), const_cast<MaskType *>(movingMask));
+  if (std::find(m_StructureNames.begin(), m_StructureNames.end(), name) == m_StructureNames.end())
+    m_StructureNames.push_back(name);
+  this->Modified();
+}
+
+template <typename TFixedImage, typename TMovingImage>
+void
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::RemoveStructure(const std::string & name)
+{
+  const auto it = std::find(m_StructureNames.begin(), m_StructureNames.end(), name);
+  if (it == m_StructureNames.end())
+    return;
+  this->ProcessObject::RemoveInput(morea::detail::FixedStructureInputName(name));
+  this->ProcessObject::RemoveInput(morea::detail::MovingStructureInputName(name));
+  m_StructureNames.erase(it);
+  this->Modified();
+}
+
+template <typename TFixedImage, typename TMovingImage>
+void
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::RemoveAllStructures()
+{
+  const auto names = m_StructureNames;
+  for (const auto & name : names)
+    this->RemoveStructure(name);
+}
+
+template <typename TFixedImage, typename TMovingImage>
+auto
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GetFixedStructureMask(const std::string & name) const
+  -> const MaskType *
+{
+  return itkDynamicCastInDebugMode<const MaskType *>(
+    this->ProcessObject::GetInput(morea::detail::FixedStructureInputName(name)));
+}
+
+template <typename TFixedImage, typename TMovingImage>
+auto
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GetMovingStructureMask(const std::string & name) const
+  -> const MaskType *
+{
+  return itkDynamicCastInDebugMode<const MaskType *>(
+    this->ProcessObject::GetInput(morea::detail::MovingStructureInputName(name)));
+}
+
+template <typename TFixedImage, typename TMovingImage>
+void
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::SetParameters(const ParameterSetType & parameters)
+{
+  m_Parameters = parameters;
+  this->Modified();
+}
+
+template <typename TFixedImage, typename TMovingImage>
+void
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::SetParameterFile(const std::string & path)
+{
+  try
+  {
+    this->SetParameters(ParameterSetType::FromFile(path));
+  }
+  catch (const std::exception & e)
+  {
+    itkExceptionMacro(<< e.what());
+  }
+}
+
+template <typename TFixedImage, typename TMovingImage>
+void
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::SetParameter(const std::string & key,
+                                                                              const std::string & value)
+{
+  try
+  {
+    m_Parameters.SetFromString(key, value);
+  }
+  catch (const std::exception & e)
+  {
+    itkExceptionMacro(<< e.what());
+  }
+  this->Modified();
+}
+
+template <typename TFixedImage, typename TMovingImage>
+void
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::SetNumberOfGenerations(SizeValueType generations)
+{
+  this->SetParameter("ea_num_generations", std::to_string(generations));
+}
+
+template <typename TFixedImage, typename TMovingImage>
+SizeValueType
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GetNumberOfGenerations() const
+{
+  return static_cast<SizeValueType>(m_Parameters.GetInteger("ea_num_generations"));
+}
+
+template <typename TFixedImage, typename TMovingImage>
+void
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::SetPopulationSize(SizeValueType size)
+{
+  this->SetParameter("ea_population_size", std::to_string(size));
+}
+
+template <typename TFixedImage, typename TMovingImage>
+SizeValueType
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GetPopulationSize() const
+{
+  return static_cast<SizeValueType>(m_Parameters.GetInteger("ea_population_size"));
+}
+
+template <typename TFixedImage, typename TMovingImage>
+void
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::SetSeed(SizeValueType seed)
+{
+  this->SetParameter("seed", std::to_string(seed));
+}
+
+template <typename TFixedImage, typename TMovingImage>
+SizeValueType
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GetSeed() const
+{
+  return static_cast<SizeValueType>(m_Parameters.GetInteger("seed"));
+}
+
+template <typename TFixedImage, typename TMovingImage>
+ProcessObject::DataObjectPointer
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::MakeOutput(DataObjectPointerArraySizeType idx)
+{
+  if (idx == 0)
+  {
+    return ApproximationSetDecorator::New().GetPointer();
+  }
+  if (idx == 1)
+  {
+    auto rigid = RigidTransformType::New();
+    rigid->SetIdentity();
+    auto decorator = DecoratedRigidTransformType::New();
+    decorator->Set(rigid);
+    return decorator.GetPointer();
+  }
+  return DecoratedDisplacementFieldTransformType::New().GetPointer();
+}
+
+template <typename TFixedImage, typename TMovingImage>
+void
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::VerifyPreconditions() ITKv5_CONST
+{
+  Superclass::VerifyPreconditions();
+  // A bad selection would otherwise only show after the whole run.
+  try
+  {
+    morea::CheckSolutionSelection(m_Selection);
+  }
+  catch (const std::exception & e)
+  {
+    itkExceptionMacro(<< e.what());
+  }
+}
+
+template <typename TFixedImage, typename TMovingImage>
+template <typename TImage>
+auto
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::ToInternalImage(const TImage * image)
+  -> InternalImageType::Pointer
+{
+  if constexpr (std::is_same_v<TImage, InternalImageType>)
+  {
+    // The problem only reads its images: share the input rather than copy it.
+    return const_cast<InternalImageType *>(image);
+  }
+  else
+  {
+    // Not in place: that would hand the caller's buffer to the output.
+    using CastFilterType = CastImageFilter<TImage, InternalImageType>;
+    auto cast = CastFilterType::New();
+    cast->SetInput(image);
+    cast->InPlaceOff();
+    cast->Update();
+    InternalImageType::Pointer output = cast->GetOutput();
+    output->DisconnectPipeline();
+    return output;
+  }
+}
+
+template <typename TFixedImage, typename TMovingImage>
+void
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GenerateData()
+{
+  // Results of an earlier run must not survive a failed one.
+  m_LastGenerationRecord = {};
+  m_GenerationHistory.clear();
+  m_ResumedAtGeneration = 0;
+  m_SelectedSolutionIndices.clear();
+  m_SelectedSolutionLabels.clear();
+  m_PreprocessedFixedImage = nullptr;
+  m_PreprocessedMovingImage = nullptr;
+  m_PreprocessReport = {};
+  static_cast<ApproximationSetDecorator *>(this->ProcessObject::GetOutput(0))->Set(ApproximationSetType{});
+  this->SetNumberOfIndexedOutputs(FirstSolutionOutput);
+  this->UpdateProgress(0.0f);
+
+  morea::MultiObjectiveRegistrationRun run;
+  try
+  {
+    morea::RegistrationProblem problem;
+    problem.fixedImage = ToInternalImage(this->GetFixedImage());
+    problem.movingImage = ToInternalImage(this->GetMovingImage());
+    for (const auto & name : m_StructureNames)
+    {
+      morea::Structure structure;
+      structure.name = name;
+      structure.fixedMask = const_cast<MaskType *>(this->GetFixedStructureMask(name));
+      structure.movingMask = const_cast<MaskType *>(this->GetMovingStructureMask(name));
+      problem.structures.push_back(std::move(structure));
+    }
+    problem.fixedBodyMask = const_cast<MaskType *>(this->GetFixedBodyMask());
+    problem.movingBodyMask = const_cast<MaskType *>(this->GetMovingBodyMask());
+
+    morea::MeshRegistrationOptions options;
+    options.checkpointPath = m_CheckpointFile;
+    options.checkpointInterval = m_CheckpointInterval;
+    options.resume = m_Resume;
+    options.threads = m_NumberOfThreadsToUse;
+    // Between generations is the only point the run can stop at cleanly; both
+    // callbacks check, so that an observer of either event stops it at once.
+    const auto stopIfAborted = [this]() {
+      if (this->GetAbortGenerateData())
+      {
+        ProcessAborted aborted(__FILE__, __LINE__);
+        aborted.SetDescription("MultiObjectiveMeshRegistrationFilter: aborted after generation " +
+                               std::to_string(m_LastGenerationRecord.generation));
+        throw aborted;
+      }
+    };
+    options.onGeneration = [this, stopIfAborted](const GenerationRecordType & record, std::size_t) {
+      m_LastGenerationRecord = record;
+      this->InvokeEvent(IterationEvent());
+      stopIfAborted();
+    };
+    const auto progress = [this, stopIfAborted](double fraction) {
+      this->UpdateProgress(static_cast<float>(fraction));
+      stopIfAborted();
+    };
+    run = morea::RunMultiObjectiveRegistration(problem, m_Parameters, options, m_Selection, progress);
+  }
+  catch (const ExceptionObject &)
+  {
+    throw;
+  }
+  catch (const std::exception & e)
+  {
+    // Core errors (::morea::Error) carry a message meant for the user.
+    itkExceptionMacro(<< e.what());
+  }
+
+  m_GenerationHistory = std::move(run.history);
+  if (!m_GenerationHistory.empty())
+    m_LastGenerationRecord = m_GenerationHistory.back();
+  m_ResumedAtGeneration = static_cast<SizeValueType>(run.resumedAtGeneration);
+  m_PreprocessedFixedImage = run.preprocessedFixedImage;
+  m_PreprocessedMovingImage = run.preprocessedMovingImage;
+  m_PreprocessReport = run.preprocessReport;
+
+  static_cast<ApproximationSetDecorator *>(this->ProcessObject::GetOutput(0))->Set(run.approximationSet);
+  static_cast<DecoratedRigidTransformType *>(this->ProcessObject::GetOutput(1))->Set(run.rigidTransform);
+
+  this->SetNumberOfIndexedOutputs(FirstSolutionOutput + 2 * run.selected.size());
+  for (std::size_t i = 0; i < run.selected.size(); ++i)
+  {
+    const auto & selected = run.selected[i];
+    m_SelectedSolutionIndices.push_back(static_cast<SizeValueType>(selected.choice.index));
+    m_SelectedSolutionLabels.push_back(selected.choice.label);
+    const DataObjectPointerArraySizeType first = FirstSolutionOutput + 2 * i;
+    for (DataObjectPointerArraySizeType o : { first, first + 1 })
+      if (this->ProcessObject::GetOutput(o) == nullptr)
+        this->SetNthOutput(o, this->MakeOutput(o));
+    static_cast<DecoratedDisplacementFieldTransformType *>(this->ProcessObject::GetOutput(first))
+      ->Set(selected.fixedToMoving);
+    static_cast<DecoratedDisplacementFieldTransformType *>(this->ProcessObject::GetOutput(first + 1))
+      ->Set(selected.movingToFixed);
+  }
+  this->UpdateProgress(1.0f);
+}
+
+template <typename TFixedImage, typename TMovingImage>
+auto
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GetApproximationSetOutput() const
+  -> const ApproximationSetDecorator *
+{
+  return static_cast<const ApproximationSetDecorator *>(this->ProcessObject::GetOutput(0));
+}
+
+template <typename TFixedImage, typename TMovingImage>
+auto
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GetApproximationSet() const
+  -> const ApproximationSetType &
+{
+  return this->GetApproximationSetOutput()->Get();
+}
+
+template <typename TFixedImage, typename TMovingImage>
+void
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::CheckSolutionIndex(SizeValueType i) const
+{
+  if (i >= m_SelectedSolutionIndices.size())
+  {
+    itkExceptionMacro("chosen solution " << i << " requested, but " << m_SelectedSolutionIndices.size()
+                                         << " were chosen (selection '" << m_Selection
+                                         << "'; outputs exist after Update())");
+  }
+}
+
+template <typename TFixedImage, typename TMovingImage>
+SizeValueType
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GetSelectedSolutionIndex(SizeValueType i) const
+{
+  this->CheckSolutionIndex(i);
+  return m_SelectedSolutionIndices[i];
+}
+
+template <typename TFixedImage, typename TMovingImage>
+const std::string &
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GetSelectedSolutionLabel(SizeValueType i) const
+{
+  this->CheckSolutionIndex(i);
+  return m_SelectedSolutionLabels[i];
+}
+
+template <typename TFixedImage, typename TMovingImage>
+auto
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GetFixedToMovingTransformOutput(
+  SizeValueType i) const -> const DecoratedDisplacementFieldTransformType *
+{
+  this->CheckSolutionIndex(i);
+  return static_cast<const DecoratedDisplacementFieldTransformType *>(
+    this->ProcessObject::GetOutput(FirstSolutionOutput + 2 * i));
+}
+
+template <typename TFixedImage, typename TMovingImage>
+auto
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GetFixedToMovingTransform(SizeValueType i) const
+  -> const DisplacementFieldTransformType *
+{
+  return this->GetFixedToMovingTransformOutput(i)->Get();
+}
+
+template <typename TFixedImage, typename TMovingImage>
+auto
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GetMovingToFixedTransformOutput(
+  SizeValueType i) const -> const DecoratedDisplacementFieldTransformType *
+{
+  this->CheckSolutionIndex(i);
+  return static_cast<const DecoratedDisplacementFieldTransformType *>(
+    this->ProcessObject::GetOutput(FirstSolutionOutput + 2 * i + 1));
+}
+
+template <typename TFixedImage, typename TMovingImage>
+auto
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GetMovingToFixedTransform(SizeValueType i) const
+  -> const DisplacementFieldTransformType *
+{
+  return this->GetMovingToFixedTransformOutput(i)->Get();
+}
+
+template <typename TFixedImage, typename TMovingImage>
+auto
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GetRigidTransformOutput() const
+  -> const DecoratedRigidTransformType *
+{
+  return static_cast<const DecoratedRigidTransformType *>(this->ProcessObject::GetOutput(1));
+}
+
+template <typename TFixedImage, typename TMovingImage>
+auto
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GetRigidTransform() const
+  -> const RigidTransformType *
+{
+  return this->GetRigidTransformOutput()->Get();
+}
+
+template <typename TFixedImage, typename TMovingImage>
+void
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::PrintSelf(std::ostream & os, Indent indent) const
+{
+  Superclass::PrintSelf(os, indent);
+  os << indent << "Structures: ";
+  for (std::size_t i = 0; i < m_StructureNames.size(); ++i)
+    os << (i ? ", " : "") << m_StructureNames[i];
+  os << std::endl;
+  os << indent << "Selection: " << m_Selection << std::endl;
+  os << indent << "NumberOfThreadsToUse: " << m_NumberOfThreadsToUse << std::endl;
+  os << indent << "CheckpointFile: " << m_CheckpointFile << std::endl;
+  os << indent << "CheckpointInterval: " << m_CheckpointInterval << std::endl;
+  os << indent << "Resume: " << (m_Resume ? "On" : "Off") << std::endl;
+  os << indent << "Parameters (the main keys and those set):" << std::endl;
+  morea::PrintParameters(os, m_Parameters, indent.GetNextIndent());
+  os << indent << "CurrentGeneration: " << this->GetCurrentGeneration() << std::endl;
+  os << indent << "ResumedAtGeneration: " << m_ResumedAtGeneration << std::endl;
+  const auto * set = this->GetApproximationSetOutput();
+  os << indent << "ApproximationSetSize: " << (set ? set->Get().size() : 0) << std::endl;
+  os << indent << "SelectedSolutions:";
+  for (std::size_t i = 0; i < m_SelectedSolutionIndices.size(); ++i)
+    os << " " << m_SelectedSolutionLabels[i] << "=" << m_SelectedSolutionIndices[i];
+  os << std::endl;
+  os << indent << "PreprocessedGrid: ";
+  if (m_PreprocessedFixedImage)
+    os << m_PreprocessedFixedImage->GetLargestPossibleRegion().GetSize() << " voxels of "
+       << m_PreprocessedFixedImage->GetSpacing()[0] << " mm" << std::endl;
+  else
+    os << "(none)" << std::endl;
+}
+} // namespace itk
+
+#endif

@@ -1,0 +1,113 @@
+/*=========================================================================
+ *  MultiObjectiveRegistration: the non-template half of
+ *  itk::MultiObjectiveMeshRegistrationFilter.
+ *
+ *  Preprocessing, the MOREA run, choosing solutions and rasterising them are
+ *  compiled once here; the template filter only converts its inputs and
+ *  wires the results to its outputs.
+ *=========================================================================*/
+#ifndef itkMultiObjectiveMeshRegistrationFilterSupport_h
+#define itkMultiObjectiveMeshRegistrationFilterSupport_h
+
+#include "itkIndent.h"
+#include "itkMeshRegistration.h"
+#include "itkMeshTransforms.h"
+#include "itkPreprocessing.h"
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+namespace morea
+{
+class ParameterSet;
+}
+
+namespace itk
+{
+namespace morea
+{
+/** One solution of the approximation set, without its meshes. */
+struct ApproximationSolution
+{
+  std::uint64_t         id{ 0 };
+  std::array<double, 3> objectives{ { 0.0, 0.0, 0.0 } }; ///< magnitude, intensity, guidance (minimised)
+  double                constraint{ 0.0 };               ///< fold constraint; 0 for the archive's solutions
+};
+
+bool
+operator==(const ApproximationSolution & a, const ApproximationSolution & b);
+bool
+operator!=(const ApproximationSolution & a, const ApproximationSolution & b);
+std::ostream &
+operator<<(std::ostream & os, const ApproximationSolution & s);
+
+/** The approximation set, by ascending guidance. */
+using ApproximationSet = std::vector<ApproximationSolution>;
+
+ApproximationSet
+ToApproximationSet(const std::vector<FrontSolution> & front);
+
+/** A chosen solution: why it was chosen and where it is in the approximation set. */
+struct SolutionChoice
+{
+  std::string label; ///< "best_guidance", "knee", "weighted", "nearest", "solution_<id>"
+  std::size_t index{ 0 };
+};
+
+/** Throws ::morea::Error unless `selection` is a comma-separated list of
+ *  best-guidance, knee, weighted:a:b:c, nearest:m:i:g and all, with at least one item. */
+void
+CheckSolutionSelection(const std::string & selection);
+
+/** The solutions `selection` names, in its order; a label chosen twice counts
+ *  once. Throws ::morea::Error on an empty set or a bad selection. */
+std::vector<SolutionChoice>
+SelectSolutions(const ApproximationSet & set, const std::string & selection);
+
+/** A chosen solution's registration in the preprocessed frame. */
+struct SelectedSolution
+{
+  SolutionChoice                          choice;
+  DisplacementFieldTransformType::Pointer fixedToMoving;
+  DisplacementFieldTransformType::Pointer movingToFixed;
+};
+
+/** Everything the filter outputs, from one run. */
+struct MultiObjectiveRegistrationRun
+{
+  ImageType::Pointer                     preprocessedFixedImage;
+  ImageType::Pointer                     preprocessedMovingImage;
+  RigidTransformType::Pointer            rigidTransform; ///< preprocessed frame -> original moving image
+  PreprocessReport                       preprocessReport;
+  ApproximationSet                       approximationSet;
+  std::vector<SelectedSolution>          selected;
+  std::vector<::morea::GenerationRecord> history;
+  std::string                            backend;
+  std::size_t                            resumedAtGeneration{ 0 };
+};
+
+/** Shares of the progress range: preprocessing and mesh model up to the first,
+ *  generations up to the second, rasterising the chosen solutions the rest. */
+constexpr double PreprocessingProgressShare = 0.05;
+constexpr double OptimisationProgressEnd = 0.95;
+
+/** Validates `problem`, preprocesses it, runs MOREA and rasterises the
+ *  solutions `selection` names on the preprocessed grid. `progress` (may be
+ *  empty) gets the cumulative fraction done; it and `options.onGeneration` may
+ *  throw to abort. Throws ::morea::Error (or what the callbacks throw). */
+MultiObjectiveRegistrationRun
+RunMultiObjectiveRegistration(const RegistrationProblem & problem, const ::morea::ParameterSet & parameters,
+                              const MeshRegistrationOptions & options, const std::string & selection,
+                              const std::function<void(double)> & progress);
+
+/** Prints the explicitly set parameters and the main run keys, one per line. */
+void
+PrintParameters(std::ostream & os, const ::morea::ParameterSet & parameters, Indent indent);
+} // namespace morea
+} // namespace itk
+
+#endif

@@ -1,0 +1,209 @@
+// MultiObjectiveRegistration core: MO-RV-GOMEA (SPEC 5), the multi-objective
+// real-valued gene-pool optimal mixing evolutionary algorithm, specialised to
+// the dual-dynamic mesh: FOS elements are mesh edges (6 variables per point),
+// partial evaluations touch only an element's dependent tetrahedra, and the
+// elements of one parallel group are varied and evaluated together.
+//
+// One generation: rank the population (constraint domination), select the
+// best tau*P, cluster the selection in normalised objective space
+// (k-leader-means plus one single-objective cluster per objective), estimate
+// per cluster and FOS element a normal distribution, then let every solution
+// sample each element of its cluster (parallel group by parallel group),
+// repair folds, evaluate, and accept a partial change when the result
+// dominates the parent or enters the elitist archive. Distribution
+// multipliers adapt, stalled solutions get forced improvements, the
+// population is re-evaluated in full every 50 generations, and after the
+// exploration period adaptive steering keeps the front near the best guidance.
+//
+// Randomness: generation g draws from a generator seeded by (seed, g) only,
+// so a checkpoint needs no generator state and any thread count gives the
+// same result.
+#ifndef morea_MoRvGomea_h
+#define morea_MoRvGomea_h
+
+#include "morea/ElitistArchive.h"
+#include "morea/EvaluationBackend.h"
+#include "morea/FoldConstraint.h"
+#include "morea/ParallelStructure.h"
+#include "morea/Random.h"
+#include "morea/TetrahedralMesh.h"
+
+#include <cstdint>
+#include <functional>
+#include <iosfwd>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace morea
+{
+class ParameterSet;
+
+struct GomeaOptions
+{
+  std::size_t   populationSize{ 700 };
+  std::size_t   numberOfClusters{ 10 };
+  std::size_t   archiveCapacity{ 2000 };
+  std::size_t   generations{ 500 };
+  double        selectionFraction{ 0.35 }; ///< tau
+  bool          steeringEnabled{ true };
+  std::size_t   steeringStart{ 100 };
+  double        steeringThreshold{ 1.5 };
+  bool          repair{ true };
+  std::size_t   fullEvaluationInterval{ 50 };
+  std::uint64_t seed{ 0 };
+
+  /** ea_* keys, morea_repair_method and seed. */
+  static GomeaOptions
+  FromParameters(const ParameterSet & parameters);
+};
+
+/** What one generation achieved (the per-generation log). */
+struct GenerationRecord
+{
+  std::size_t generation{ 0 };
+  double      hypervolume{ 0.0 };  ///< of the archive, objectives divided by the reference point
+  double      bestGuidance{ 0.0 }; ///< in the archive
+  std::size_t archiveSize{ 0 };
+  std::size_t feasible{ 0 };            ///< fold-free solutions in the population
+  std::size_t accepted{ 0 };            ///< partial changes accepted this generation
+  std::size_t candidates{ 0 };          ///< partial changes sampled this generation
+  std::size_t folded{ 0 };              ///< of which folded a tetrahedron (before repair)
+  std::size_t repaired{ 0 };            ///< candidates whose folds the repair removed
+  std::size_t forcedImprovements{ 0 };
+  double      meanMultiplier{ 0.0 };    ///< over clusters and elements
+  double      tetrahedronEvaluations{ 0.0 }; ///< this generation
+  double      seconds{ 0.0 };           ///< wall time of this generation
+};
+
+/** Per cluster and FOS element: what carries over between generations. */
+struct DistributionState
+{
+  std::vector<double> previousMean; ///< empty before the first estimate
+  double              multiplier{ 1.0 };
+  std::size_t         noImprovementStretch{ 0 };
+};
+
+class MoRvGomea
+{
+public:
+  /** All references must outlive the optimiser. */
+  MoRvGomea(const TetrahedralMesh & base, const MeshTopology & topology, const ParallelStructure & parallel,
+            const FoldConstraint & constraint, EvaluationBackend & backend, const GomeaOptions & options);
+  ~MoRvGomea();
+
+  /** Evaluates `population` (size populationSize; folded solutions are
+   *  repaired first) and seeds the archive. */
+  void
+  Initialize(std::vector<DualMesh> population);
+
+  /** One generation; throws when called after the last. */
+  void
+  RunGeneration();
+
+  /** Generations until Finished(), calling `onGeneration` after each (it may
+   *  throw to abort). */
+  void
+  Run(const std::function<void(const GenerationRecord &)> & onGeneration = {});
+
+  bool
+  Finished() const
+  {
+    return m_Generation >= m_Options.generations;
+  }
+  std::size_t
+  Generation() const
+  {
+    return m_Generation;
+  }
+  const ElitistArchive &
+  Archive() const
+  {
+    return *m_Archive;
+  }
+  const std::vector<GenerationRecord> &
+  History() const
+  {
+    return m_History;
+  }
+  const GomeaOptions &
+  Options() const
+  {
+    return m_Options;
+  }
+  /** Current population and its fitness (after any steering). */
+  const std::vector<DualMesh> &
+  Population() const
+  {
+    return m_Population;
+  }
+  std::vector<Fitness>
+  PopulationFitness() const;
+  /** The raw (unsteered) fitness of any solution, evaluated in full. */
+  Fitness
+  EvaluateFully(const DualMesh & solution);
+
+  /** The whole optimiser state in a portable binary form, and back. Load
+   *  checks the checkpoint matches this problem (mesh and options). */
+  void
+  Save(std::ostream & out) const;
+  void
+  Load(std::istream & in);
+  /** Atomic: written to a temporary name, then renamed. */
+  void
+  SaveCheckpoint(const std::string & path) const;
+  void
+  LoadCheckpoint(const std::string & path);
+
+private:
+  struct ClusterModel;
+  struct Candidate;
+
+  Fitness
+  Steered(const Fitness & raw) const;
+  Fitness
+  CurrentFitness(std::size_t solution) const;
+  void
+  EvaluatePopulationFully();
+  std::vector<std::size_t>
+  Select(const std::vector<Fitness> & fitness, RandomGenerator & random) const;
+  std::vector<ClusterModel>
+  BuildClusters(const std::vector<std::size_t> & selection, const std::vector<Fitness> & fitness,
+                RandomGenerator & random);
+  void
+  EstimateDistributions(std::vector<ClusterModel> & clusters) const;
+  /** Repairs (when enabled) and evaluates `candidates`, then accepts them in
+   *  order; returns how many were accepted. */
+  std::size_t
+  ProcessCandidates(std::vector<Candidate> & candidates, GenerationRecord & record);
+  void
+  ForcedImprovement(std::size_t solution, int singleObjective, RandomGenerator & random, GenerationRecord & record);
+  bool
+  InsertIntoArchive(std::size_t solution, const Fitness & fitness);
+  GenerationRecord
+  Summarise(std::size_t generation) const;
+
+  const TetrahedralMesh &   m_Base;
+  const MeshTopology &      m_Topology;
+  const ParallelStructure & m_Parallel;
+  const FoldConstraint &    m_Constraint;
+  EvaluationBackend &       m_Backend;
+  GomeaOptions              m_Options;
+
+  std::size_t                             m_Generation{ 0 };
+  std::vector<DualMesh>                   m_Population;
+  std::vector<std::uint64_t>              m_Ids;
+  std::vector<ObjectiveTotals>            m_Totals;
+  std::vector<std::vector<TetrahedronValues>> m_TetValues;
+  std::vector<std::size_t>                m_NoImprovement; ///< per solution, generations without an accepted change
+  std::uint64_t                           m_NextId{ 0 };
+  std::unique_ptr<ElitistArchive>         m_Archive;
+  ObjectiveVector                         m_Reference{ { 1.0, 1.0, 1.0 } }; ///< hypervolume reference
+  std::vector<std::vector<DistributionState>> m_Distributions;   ///< per cluster (k + objectives), per element
+  std::vector<ObjectiveVector>            m_ClusterMeans;   ///< previous generation's, for matching
+  std::vector<GenerationRecord>           m_History;
+  double                                  m_SteeringLimit; ///< guidance bound; infinity when inactive
+};
+} // namespace morea
+
+#endif

@@ -1,0 +1,77 @@
+// MultiObjectiveRegistration core: objective vectors, constraint domination,
+// non-dominated sorting, hypervolume and the helpers that pick one solution of
+// an approximation set (SPEC 5 and 7).
+#ifndef morea_ParetoFront_h
+#define morea_ParetoFront_h
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace morea
+{
+/** All objectives are minimised. */
+enum class Objective : std::size_t
+{
+  Magnitude = 0, ///< deformation magnitude
+  Intensity = 1, ///< image dissimilarity
+  Guidance = 2   ///< contour distance
+};
+constexpr std::size_t NumberOfObjectives = 3;
+using ObjectiveVector = std::array<double, NumberOfObjectives>;
+
+inline double
+Value(const ObjectiveVector & v, Objective o)
+{
+  return v[static_cast<std::size_t>(o)];
+}
+
+/** A solution's standing: its objectives and, when infeasible, how badly. */
+struct Fitness
+{
+  ObjectiveVector objectives{ { 0.0, 0.0, 0.0 } };
+  bool            feasible{ true };
+  double          constraint{ 0.0 }; ///< > = 0; compared only between infeasible solutions
+};
+
+/** Pareto dominance of objective vectors: no worse in all, better in one. */
+bool
+Dominates(const ObjectiveVector & a, const ObjectiveVector & b);
+
+/** Constraint domination (Deb): feasible beats infeasible; of two infeasible
+ *  solutions the smaller constraint value wins; two feasible ones compare by
+ *  Pareto dominance. */
+bool
+ConstraintDominates(const Fitness & a, const Fitness & b);
+
+/** Non-domination rank under constraint domination: 0 for the first front. */
+std::vector<std::size_t>
+NonDominatedRanks(const std::vector<Fitness> & population);
+
+/** Hypervolume dominated by `points` and bounded by `reference` (3 objectives,
+ *  exact). Points not strictly better than the reference in every objective
+ *  contribute nothing. */
+double
+Hypervolume(const std::vector<ObjectiveVector> & points, const ObjectiveVector & reference);
+
+/** Choosing one solution of a front (indices into `front`; all throw
+ *  morea::Error on an empty front). Objectives are first normalised to [0,1]
+ *  by the front's range (an objective with zero range counts as 0). */
+/** Smallest guidance value; ties broken by the smaller normalised sum. */
+std::size_t
+SelectBestGuidance(const std::vector<ObjectiveVector> & front);
+/** Knee point: the solution farthest below the plane through the front's
+ *  extreme solutions (for fewer than 3 distinct extremes, the one nearest the
+ *  ideal point). */
+std::size_t
+SelectKnee(const std::vector<ObjectiveVector> & front);
+/** Smallest weighted sum of normalised objectives (weights >= 0, not all 0). */
+std::size_t
+SelectWeighted(const std::vector<ObjectiveVector> & front, const ObjectiveVector & weights);
+/** Nearest to `point` (raw objective units, normalised like the front). */
+std::size_t
+SelectNearest(const std::vector<ObjectiveVector> & front, const ObjectiveVector & point);
+} // namespace morea
+
+#endif

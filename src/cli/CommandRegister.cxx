@@ -1,0 +1,89 @@
+// `morea register`: preprocesses a problem, runs MOREA and writes the
+// approximation set, the chosen solutions and their scores.
+#include "CommandCommon.h"
+#include "RegistrationOutputs.h"
+
+#include "itkMOREAImageIO.h"
+#include "itkMeshRegistration.h"
+#include "itkPreprocessing.h"
+#include "itkRigidPreAlignment.h"
+
+#include <filesystem>
+#include <iostream>
+#include <memory>
+
+namespace morea::cli
+{
+void
+AddRegisterCommand(CLI::App & app)
+{
+  struct Options
+  {
+    ProblemOptions   problem;
+    ParameterOptions parameters;
+    std::string      output;
+    std::string      select{ "best-guidance,knee" };
+    std::size_t      checkpointEvery{ 10 };
+    bool             resume{ false };
+    std::size_t      threads{ 0 };
+  };
+  auto   options = std::make_shared<Options>();
+  auto * cmd = app.add_subcommand("register", "register a problem with MOREA and write the approximation set");
+  options->problem.AddTo(*cmd);
+  options->parameters.AddTo(*cmd);
+  cmd->add_option("-o,--output", options->output, "output folder")->required();
+  cmd->add_option("--select", options->select,
+                  "solutions to write: best-guidance, knee, weighted:a:b:c, nearest:m:i:g, all (comma-separated)")
+    ->capture_default_str();
+  cmd->add_option("--checkpoint-every", options->checkpointEvery,
+                  "write output/checkpoint.bin every N generations (0: only at the end)")
+    ->capture_default_str();
+  cmd->add_flag("--resume", options->resume, "continue from output/checkpoint.bin when it exists");
+  cmd->add_option("--threads", options->threads, "CPU threads (0: all)")->capture_default_str();
+  cmd->callback([options] {
+    namespace fs = std::filesystem;
+    const auto parameters = options->parameters.Load();
+    const auto input = options->problem.Load();
+    const auto preprocessed = itk::morea::Preprocess(input, itk::morea::PreprocessOptions::FromParameters(parameters));
+    const auto & r = preprocessed.report;
+    std::cout << "preprocessed: " << r.size[0] << "x" << r.size[1] << "x" << r.size[2] << " voxels of " << r.spacing
+              << " mm around '" << r.cropStructure << "'"
+              << (r.rigidStructure.empty() ? std::string() : ", rigid on '" + r.rigidStructure + "'") << "\n";
+    fs::create_directories(options->output);
+    const std::string out = options->output + "/";
+    itk::morea::WriteTextFile(parameters.ToToml(), out + "parameters.toml");
+    itk::morea::WriteRigidTransform(preprocessed.rigidTransform, out + "rigid_fixed_to_moving.tfm");
+
+    itk::morea::MeshRegistrationOptions run;
+    run.checkpointPath = out + "checkpoint.bin";
+    run.checkpointInterval = options->checkpointEvery;
+    run.resume = options->resume;
+    run.threads = options->threads;
+    run.onGeneration = ProgressPrinter();
+    const auto result = itk::morea::RegisterMeshes(preprocessed.problem, parameters, run);
+    if (result.resumedAtGeneration > 0)
+      std::cout << "resumed from generation " << result.resumedAtGeneration << "\n";
+    std::cout << "mesh " << result.model.base.NumberOfPoints() << " points, " << result.model.base.NumberOfTetrahedra()
+              << " tetrahedra (" << result.secondsModel << " s); optimisation " << result.secondsOptimisation
+              << " s on " << result.threads << " " << result.backend << " threads; front of " << result.front.size()
+              << "\n";
+
+    const auto chosen = ChooseSolutions(result.front, options->select);
+    const auto summary = WriteRegistrationOutputs(preprocessed, result, chosen,
+                                                  parameters.GetReal("evaluation_border_margin"), options->output);
+    for (const auto & c : chosen)
+    {
+      const auto & s = result.front[c.index];
+      std::cout << c.label << ": id " << s.id << ", magnitude " << s.fitness.objectives[0] << ", intensity "
+                << s.fitness.objectives[1] << ", guidance " << s.fitness.objectives[2] << "\n";
+      if (summary.contains("solutions") && summary["solutions"][c.label].contains("scores"))
+        for (const auto & [name, v] : summary["solutions"][c.label]["scores"]["structures"].items())
+          std::cout << "  " << name << ": Dice " << v["dice"].get<double>() << " (rigid "
+                    << summary["rigid_baseline"]["structures"][name]["dice"].get<double>() << "), HD95 "
+                    << v["hausdorff95_mm"].get<double>() << " mm (rigid "
+                    << summary["rigid_baseline"]["structures"][name]["hausdorff95_mm"].get<double>() << ")\n";
+    }
+    std::cout << "written to " << options->output << "\n";
+  });
+}
+} // namespace morea::cli

@@ -1,0 +1,221 @@
+#include "RegistrationOutputs.h"
+
+#include "itkImageRegionConstIteratorWithIndex.h"
+#include "itkMOREAImageIO.h"
+#include "itkMeshTransforms.h"
+#include "itkRegistrationEvaluation.h"
+#include "morea/Error.h"
+#include "morea/ParetoFront.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+#include <unistd.h>
+
+namespace morea::cli
+{
+namespace
+{
+std::vector<::morea::ObjectiveVector>
+Objectives(const std::vector<itk::morea::FrontSolution> & front)
+{
+  std::vector<::morea::ObjectiveVector> v;
+  for (const auto & s : front)
+    v.push_back(s.fitness.objectives);
+  return v;
+}
+
+::morea::ObjectiveVector
+ParseTriple(const std::string & item, const std::string & text)
+{
+  std::vector<std::string> parts;
+  std::istringstream       in(text);
+  for (std::string part; std::getline(in, part, ':');)
+    parts.push_back(part);
+  ::morea::ObjectiveVector v{};
+  try
+  {
+    if (parts.size() != 3)
+      throw std::invalid_argument(text);
+    for (std::size_t m = 0; m < 3; ++m)
+    {
+      std::size_t used = 0;
+      v[m] = std::stod(parts[m], &used);
+      if (used != parts[m].size())
+        throw std::invalid_argument(parts[m]);
+    }
+  }
+  catch (const std::exception &)
+  {
+    throw ::morea::Error("--select: '" + item + "' needs three numbers (magnitude:intensity:guidance)");
+  }
+  return v;
+}
+
+/** Mean |u - truth| in mm over the voxels inside the body (intensity > 0). */
+double
+MeanDisplacementError(const itk::morea::DisplacementFieldType * field, const itk::morea::DisplacementFieldType * truth,
+                      const itk::morea::ImageType * fixed)
+{
+  using namespace itk::morea;
+  double      sum = 0.0;
+  std::size_t n = 0;
+  for (itk::ImageRegionConstIteratorWithIndex<DisplacementFieldType> it(field, field->GetBufferedRegion()); !it.IsAtEnd();
+       ++it)
+  {
+    if (!(fixed->GetPixel(it.GetIndex()) > 0.0f))
+      continue;
+    sum += (it.Get() - truth->GetPixel(it.GetIndex())).GetNorm();
+    ++n;
+  }
+  return n ? sum / static_cast<double>(n) : 0.0;
+}
+} // namespace
+
+std::vector<ChosenSolution>
+ChooseSolutions(const std::vector<itk::morea::FrontSolution> & front, const std::string & selection)
+{
+  if (front.empty())
+    throw ::morea::Error("the approximation set is empty: no fold-free solution was found");
+  const auto                  objectives = Objectives(front);
+  std::vector<ChosenSolution> chosen;
+  auto                        add = [&](const std::string & label, std::size_t index) {
+    for (const auto & c : chosen)
+      if (c.label == label)
+        return;
+    chosen.push_back({ label, index });
+  };
+  for (const std::string & item : ::morea::ParseNameList(selection))
+  {
+    if (item == "best-guidance")
+      add("best_guidance", ::morea::SelectBestGuidance(objectives));
+    else if (item == "knee")
+      add("knee", ::morea::SelectKnee(objectives));
+    else if (item == "all")
+      for (std::size_t i = 0; i < front.size(); ++i)
+        add("solution_" + std::to_string(front[i].id), i);
+    else if (item.rfind("weighted:", 0) == 0)
+      add("weighted", ::morea::SelectWeighted(objectives, ParseTriple(item, item.substr(9))));
+    else if (item.rfind("nearest:", 0) == 0)
+      add("nearest", ::morea::SelectNearest(objectives, ParseTriple(item, item.substr(8))));
+    else
+      throw ::morea::Error("--select: unknown choice '" + item +
+                           "' (best-guidance, knee, weighted:a:b:c, nearest:m:i:g, all)");
+  }
+  if (chosen.empty())
+    throw ::morea::Error("--select: no solution chosen");
+  return chosen;
+}
+
+std::function<void(const ::morea::GenerationRecord &, std::size_t)>
+ProgressPrinter()
+{
+  const bool terminal = isatty(fileno(stdout)) != 0;
+  return [terminal](const ::morea::GenerationRecord & r, std::size_t total) {
+    char line[200];
+    std::snprintf(line, sizeof line, "generation %zu/%zu  front %zu  best guidance %.4g  hypervolume %.4f  %.2f s",
+                  r.generation, total, r.archiveSize, r.bestGuidance, r.hypervolume, r.seconds);
+    if (terminal)
+    {
+      const int width = 24;
+      const int done = static_cast<int>(width * static_cast<double>(r.generation) / static_cast<double>(total));
+      std::cout << "\r[" << std::string(static_cast<std::size_t>(done), '#')
+                << std::string(static_cast<std::size_t>(width - done), '.') << "] " << line << "   " << std::flush;
+      if (r.generation == total)
+        std::cout << "\n";
+    }
+    else if (r.generation % 10 == 0 || r.generation == total)
+      std::cout << line << "\n" << std::flush;
+  };
+}
+
+nlohmann::json
+WriteRegistrationOutputs(const itk::morea::PreprocessResult & preprocessed,
+                         const itk::morea::MeshRegistrationResult & result,
+                         const std::vector<ChosenSolution> & chosen, double borderMargin, const std::string & folder,
+                         const itk::morea::DisplacementFieldType * trueFixedToMoving)
+{
+  using namespace itk::morea;
+  namespace fs = std::filesystem;
+  const auto & problem = preprocessed.problem;
+  fs::create_directories(folder);
+  const std::string out = folder + "/";
+
+  // The front.
+  std::ostringstream csv;
+  csv.precision(10);
+  csv << "id,magnitude,intensity,guidance,constraint,chosen\n";
+  nlohmann::json front = nlohmann::json::array();
+  for (std::size_t i = 0; i < result.front.size(); ++i)
+  {
+    const auto & s = result.front[i];
+    std::string  labels;
+    for (const auto & c : chosen)
+      if (c.index == i)
+        labels += (labels.empty() ? "" : ";") + c.label;
+    csv << s.id << "," << s.fitness.objectives[0] << "," << s.fitness.objectives[1] << "," << s.fitness.objectives[2]
+        << "," << s.fitness.constraint << "," << labels << "\n";
+    front.push_back({ { "id", s.id },
+                      { "magnitude", s.fitness.objectives[0] },
+                      { "intensity", s.fitness.objectives[1] },
+                      { "guidance", s.fitness.objectives[2] },
+                      { "constraint", s.fitness.constraint },
+                      { "feasible", s.fitness.feasible },
+                      { "chosen", labels } });
+  }
+  WriteTextFile(csv.str(), out + "front.csv");
+  WriteJson({ { "objectives", { "magnitude", "intensity", "guidance" } }, { "solutions", front } }, out + "front.json");
+
+  // The per-generation log.
+  std::ostringstream log;
+  log.precision(10);
+  log << "generation,hypervolume,best_guidance,archive_size,feasible,candidates,folded,accepted,repaired,forced_improvements,"
+         "mean_multiplier,tetrahedron_evaluations,seconds\n";
+  for (const auto & r : result.history)
+    log << r.generation << "," << r.hypervolume << "," << r.bestGuidance << "," << r.archiveSize << "," << r.feasible
+        << "," << r.candidates << "," << r.folded << "," << r.accepted << "," << r.repaired << "," << r.forcedImprovements << "," << r.meanMultiplier << ","
+        << r.tetrahedronEvaluations << "," << r.seconds << "\n";
+  WriteTextFile(log.str(), out + "generations.csv");
+
+  // The chosen solutions.
+  const bool     scored = !problem.structures.empty() || !problem.fixedLandmarks.empty();
+  nlohmann::json summary;
+  if (scored)
+    summary["rigid_baseline"] = ToJson(EvaluateRegistration(problem, nullptr, nullptr, borderMargin));
+  for (const auto & c : chosen)
+  {
+    const auto &      s = result.front[c.index];
+    const std::string dir = out + c.label + "/";
+    fs::create_directories(dir);
+    const MeshFields fields = RasterizeSolution(result.model.topology, s.mesh, problem.fixedImage, problem.movingImage);
+    WriteDisplacementField(fields.fixedToMoving, dir + "preprocessed_fixed_to_moving.nii.gz");
+    WriteDisplacementField(fields.movingToFixed, dir + "preprocessed_moving_to_fixed.nii.gz");
+    WriteSolutionTransforms(fields, preprocessed.rigidTransform, dir + "fixed_to_moving.h5", dir + "moving_to_fixed.h5");
+    WriteSolutionMeshes(result.model, s.mesh, dir + "mesh_moving.vtu", dir + "mesh_fixed.vtu");
+    nlohmann::json entry = { { "id", s.id },
+                             { "magnitude", s.fitness.objectives[0] },
+                             { "intensity", s.fitness.objectives[1] },
+                             { "guidance", s.fitness.objectives[2] } };
+    if (scored)
+    {
+      const auto scores = EvaluateRegistration(problem, fields.fixedToMoving, fields.movingToFixed, borderMargin);
+      entry["scores"] = ToJson(scores);
+      if (trueFixedToMoving)
+        entry["mean_displacement_error_in_body_mm"] =
+          MeanDisplacementError(fields.fixedToMoving, trueFixedToMoving, problem.fixedImage);
+      WriteJson(entry, dir + "scores.json");
+      RenderComparison(problem, fields.fixedToMoving, preprocessed.report.cropStructure, dir + "render");
+    }
+    summary["solutions"][c.label] = entry;
+  }
+  summary["front_size"] = result.front.size();
+  summary["generations"] = result.history.empty() ? 0 : result.history.back().generation;
+  summary["backend"] = result.backend;
+  summary["threads"] = result.threads;
+  summary["seconds"] = { { "model", result.secondsModel }, { "optimisation", result.secondsOptimisation } };
+  WriteJson(summary, out + "summary.json");
+  return summary;
+}
+} // namespace morea::cli

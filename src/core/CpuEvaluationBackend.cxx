@@ -1,0 +1,104 @@
+// The CPU evaluation backend: the reference implementation of
+// EvaluationBackend, multi-threaded over the tetrahedra of whole solutions and
+// over the candidates of a parallel group.
+#include "morea/EvaluationBackend.h"
+
+#include "morea/Error.h"
+#include "morea/ThreadPool.h"
+
+#include <algorithm>
+
+namespace morea
+{
+void
+CandidateCorners(const PartialCandidate & c, const Tetrahedron & t, Corners & source, Corners & target)
+{
+  const auto & moved = c.element->points;
+  for (int i = 0; i < 4; ++i)
+  {
+    const auto it = std::find(moved.begin(), moved.end(), t[i]);
+    if (it == moved.end())
+    {
+      source[i] = c.parent->source[t[i]];
+      target[i] = c.parent->target[t[i]];
+    }
+    else
+    {
+      const auto k = static_cast<std::size_t>(it - moved.begin());
+      source[i] = c.source[k];
+      target[i] = c.target[k];
+    }
+  }
+}
+
+namespace
+{
+class CpuEvaluationBackend final : public EvaluationBackend
+{
+public:
+  CpuEvaluationBackend(const TetrahedronEvaluator & evaluator, std::size_t threads)
+    : m_Evaluator(evaluator)
+    , m_Pool(threads)
+  {}
+
+  std::string
+  Name() const override
+  {
+    return "cpu";
+  }
+
+  void
+  EvaluateSolutions(const std::vector<const DualMesh *> & solutions,
+                    const std::vector<std::vector<TetrahedronValues> *> & values) override
+  {
+    if (solutions.size() != values.size())
+      throw Error("evaluation backend: as many value arrays as solutions are needed");
+    const std::size_t tets = m_Evaluator.Topology().NumberOfTetrahedra();
+    const std::size_t points = m_Evaluator.Topology().NumberOfPoints();
+    for (std::size_t i = 0; i < solutions.size(); ++i)
+    {
+      if (solutions[i]->source.size() != points || solutions[i]->target.size() != points)
+        throw Error("evaluation backend: a solution does not match the mesh");
+      values[i]->assign(tets, TetrahedronValues{});
+    }
+    // Chunks of tetrahedra across all solutions keep every thread busy even
+    // for a single solution.
+    constexpr std::size_t chunk = 64;
+    const std::size_t     chunksPerSolution = (tets + chunk - 1) / chunk;
+    m_Pool.ParallelFor(solutions.size() * chunksPerSolution, [&](std::size_t job) {
+      const std::size_t s = job / chunksPerSolution;
+      const std::size_t begin = (job % chunksPerSolution) * chunk;
+      const std::size_t end = std::min(tets, begin + chunk);
+      for (std::size_t t = begin; t < end; ++t)
+        (*values[s])[t] = m_Evaluator.Evaluate(t, *solutions[s]);
+    });
+  }
+
+  void
+  EvaluatePartials(const std::vector<PartialCandidate> & candidates) override
+  {
+    const auto & tets = m_Evaluator.Topology().Tetrahedra();
+    m_Pool.ParallelFor(candidates.size(), [&](std::size_t i) {
+      const PartialCandidate & c = candidates[i];
+      Corners                  source, target;
+      const auto &             dependent = c.element->dependentTetrahedra;
+      for (std::size_t k = 0; k < dependent.size(); ++k)
+      {
+        CandidateCorners(c, tets[dependent[k]], source, target);
+        c.values[k] = m_Evaluator.Evaluate(dependent[k], source, target);
+      }
+    });
+  }
+
+private:
+  const TetrahedronEvaluator & m_Evaluator;
+  ThreadPool                   m_Pool;
+};
+} // namespace
+
+std::unique_ptr<EvaluationBackend>
+CreateCpuEvaluationBackend(const TetrahedronEvaluator & evaluator, std::size_t threads)
+{
+  return std::make_unique<CpuEvaluationBackend>(evaluator, threads);
+}
+} // namespace morea

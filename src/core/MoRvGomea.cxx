@@ -1,0 +1,930 @@
+#include "morea/MoRvGomea.h"
+
+#include "morea/Error.h"
+#include "morea/MeshRepair.h"
+#include "morea/ParameterSet.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+namespace morea
+{
+namespace
+{
+// Settings of AMaLGaM / RV-GOMEA that MO-RV-GOMEA inherits.
+constexpr double      MultiplierDecrease = 0.9;
+constexpr double      MultiplierIncrease = 1.0 / 0.9;
+constexpr double      MultiplierMaximum = 10.0;
+constexpr double      StandardDeviationRatioThreshold = 1.0;
+constexpr double      AmsDelta = 2.0;
+constexpr std::size_t KMeansIterations = 3;
+// A steering violation must rank before any fold: folds are the hard constraint.
+constexpr double FoldConstraintOffset = 1.0e12;
+
+double
+Normalised(double v, double low, double high)
+{
+  return high > low ? (v - low) / (high - low) : 0.0;
+}
+
+double
+SquaredDistance(const ObjectiveVector & a, const ObjectiveVector & b)
+{
+  double s = 0.0;
+  for (std::size_t m = 0; m < NumberOfObjectives; ++m)
+    s += (a[m] - b[m]) * (a[m] - b[m]);
+  return s;
+}
+
+/** Lower Cholesky factor of the n x n matrix `a` (row-major), regularised
+ *  on the diagonal until it exists (pinned coordinates have zero variance). */
+std::vector<double>
+RegularisedCholesky(std::vector<double> a, std::size_t n)
+{
+  double scale = 0.0;
+  for (std::size_t i = 0; i < n; ++i)
+    scale = std::max(scale, a[i * n + i]);
+  double jitter = std::max(scale, 1e-12) * 1e-10;
+  for (int attempt = 0; attempt < 40; ++attempt)
+  {
+    std::vector<double> l(n * n, 0.0);
+    bool                ok = true;
+    for (std::size_t i = 0; i < n && ok; ++i)
+      for (std::size_t j = 0; j <= i; ++j)
+      {
+        double s = a[i * n + j] + (i == j ? jitter : 0.0);
+        for (std::size_t k = 0; k < j; ++k)
+          s -= l[i * n + k] * l[j * n + k];
+        if (i == j)
+        {
+          if (!(s > 0.0))
+          {
+            ok = false;
+            break;
+          }
+          l[i * n + i] = std::sqrt(s);
+        }
+        else
+          l[i * n + j] = s / l[j * n + j];
+      }
+    if (ok)
+      return l;
+    jitter *= 10.0;
+  }
+  throw Error("optimiser: a distribution's covariance has no Cholesky factor");
+}
+
+void
+Gather(const DualMesh & solution, const FosElement & element, double * x)
+{
+  for (std::size_t k = 0; k < element.points.size(); ++k)
+    for (int a = 0; a < 3; ++a)
+    {
+      x[6 * k + a] = solution.source[element.points[k]][a];
+      x[6 * k + 3 + a] = solution.target[element.points[k]][a];
+    }
+}
+} // namespace
+
+GomeaOptions
+GomeaOptions::FromParameters(const ParameterSet & p)
+{
+  GomeaOptions o;
+  o.populationSize = static_cast<std::size_t>(p.GetInteger("ea_population_size"));
+  o.numberOfClusters = static_cast<std::size_t>(p.GetInteger("ea_num_clusters"));
+  o.archiveCapacity = static_cast<std::size_t>(p.GetInteger("ea_archive_size"));
+  o.generations = static_cast<std::size_t>(p.GetInteger("ea_num_generations"));
+  o.steeringEnabled = p.GetBool("ea_adaptive_steering_enabled");
+  o.steeringStart = static_cast<std::size_t>(p.GetInteger("ea_adaptive_steering_activated_at_num_generations"));
+  o.steeringThreshold = p.GetReal("ea_adaptive_steering_guidance_threshold");
+  o.repair = p.GetString("morea_repair_method") == "gaussian";
+  o.seed = static_cast<std::uint64_t>(p.GetInteger("seed"));
+  return o;
+}
+
+/** A cluster of the selection and its per-element distributions. */
+struct MoRvGomea::ClusterModel
+{
+  std::vector<std::size_t>         members; ///< population indices used for estimation
+  ObjectiveVector                  mean{};  ///< in normalised objective space
+  int                              singleObjective{ -1 };
+  std::vector<std::vector<double>> means;    ///< per element
+  std::vector<std::vector<double>> cholesky; ///< per element, lower, row-major
+  std::vector<std::size_t>         population; ///< solutions varied with this cluster's model
+};
+
+/** One partial change of one solution: an element's new coordinates. */
+struct MoRvGomea::Candidate
+{
+  std::size_t                    solution{ 0 };
+  std::size_t                    element{ 0 };
+  int                            singleObjective{ -1 }; ///< acceptance rule: -1 Pareto, else that objective
+  bool                           forced{ false };       ///< forced improvement: must dominate the parent
+  std::uint64_t                  seed{ 0 };             ///< for the repair
+  std::vector<Vec3>              source, target;
+  std::vector<TetrahedronValues> values;
+  std::vector<double>            sample; ///< the drawn variables (before projection), for the ratio test
+  std::size_t                    cluster{ 0 };
+  bool                           folded{ false };
+  bool                           accepted{ false };
+};
+
+MoRvGomea::MoRvGomea(const TetrahedralMesh & base, const MeshTopology & topology, const ParallelStructure & parallel,
+                     const FoldConstraint & constraint, EvaluationBackend & backend, const GomeaOptions & options)
+  : m_Base(base)
+  , m_Topology(topology)
+  , m_Parallel(parallel)
+  , m_Constraint(constraint)
+  , m_Backend(backend)
+  , m_Options(options)
+  , m_SteeringLimit(std::numeric_limits<double>::infinity())
+{
+  if (options.populationSize < 2)
+    throw Error("optimiser: the population needs at least 2 solutions");
+  if (options.numberOfClusters < 1 || options.archiveCapacity < 1)
+    throw Error("optimiser: at least one cluster and an archive of at least 1 are needed");
+  if (!(options.selectionFraction > 0.0 && options.selectionFraction <= 1.0))
+    throw Error("optimiser: the selection fraction must be in (0, 1]");
+  if (parallel.elements.empty())
+    throw Error("optimiser: the mesh has no FOS elements");
+  m_Archive = std::make_unique<ElitistArchive>(options.archiveCapacity);
+}
+
+MoRvGomea::~MoRvGomea() = default;
+
+Fitness
+MoRvGomea::Steered(const Fitness & raw) const
+{
+  Fitness f = raw;
+  if (!raw.feasible)
+    f.constraint = FoldConstraintOffset + raw.constraint;
+  else if (Value(raw.objectives, Objective::Guidance) > m_SteeringLimit)
+  {
+    f.feasible = false;
+    f.constraint = Value(raw.objectives, Objective::Guidance) - m_SteeringLimit;
+  }
+  return f;
+}
+
+Fitness
+MoRvGomea::CurrentFitness(std::size_t s) const
+{
+  return Steered(m_Totals[s].ToFitness(m_Topology.NumberOfTetrahedra()));
+}
+
+std::vector<Fitness>
+MoRvGomea::PopulationFitness() const
+{
+  std::vector<Fitness> f(m_Population.size());
+  for (std::size_t s = 0; s < f.size(); ++s)
+    f[s] = CurrentFitness(s);
+  return f;
+}
+
+void
+MoRvGomea::EvaluatePopulationFully()
+{
+  std::vector<const DualMesh *>                 solutions;
+  std::vector<std::vector<TetrahedronValues> *> values;
+  for (std::size_t s = 0; s < m_Population.size(); ++s)
+  {
+    solutions.push_back(&m_Population[s]);
+    values.push_back(&m_TetValues[s]);
+  }
+  m_Backend.EvaluateSolutions(solutions, values);
+  for (std::size_t s = 0; s < m_Population.size(); ++s)
+  {
+    m_Totals[s] = ObjectiveTotals{};
+    for (const auto & v : m_TetValues[s])
+      m_Totals[s].Add(v);
+  }
+}
+
+Fitness
+MoRvGomea::EvaluateFully(const DualMesh & solution)
+{
+  std::vector<TetrahedronValues> values;
+  m_Backend.EvaluateSolutions({ &solution }, { &values });
+  ObjectiveTotals totals;
+  for (const auto & v : values)
+    totals.Add(v);
+  return totals.ToFitness(m_Topology.NumberOfTetrahedra());
+}
+
+bool
+MoRvGomea::InsertIntoArchive(std::size_t s, const Fitness & fitness)
+{
+  if (!m_Archive->Accepts(fitness))
+    return false;
+  return m_Archive->Insert(fitness, m_Population[s], m_Ids[s]);
+}
+
+void
+MoRvGomea::Initialize(std::vector<DualMesh> population)
+{
+  if (population.size() != m_Options.populationSize)
+    throw Error("optimiser: expected " + std::to_string(m_Options.populationSize) + " initial solutions, got " +
+                std::to_string(population.size()));
+  RandomGenerator random(HashCombine(m_Options.seed, 0x1417));
+  for (auto & solution : population)
+  {
+    if (solution.source.size() != m_Topology.NumberOfPoints() || solution.target.size() != m_Topology.NumberOfPoints())
+      throw Error("optimiser: an initial solution does not match the mesh");
+    if (m_Options.repair && !m_Constraint.Evaluate(solution).Feasible())
+      RepairFolds(solution, m_Base, m_Constraint, random);
+  }
+  m_Population = std::move(population);
+  m_Ids.resize(m_Population.size());
+  std::iota(m_Ids.begin(), m_Ids.end(), std::uint64_t{ 0 });
+  m_NextId = m_Population.size();
+  m_Totals.assign(m_Population.size(), ObjectiveTotals{});
+  m_TetValues.assign(m_Population.size(), {});
+  m_NoImprovement.assign(m_Population.size(), 0);
+  m_Generation = 0;
+  m_History.clear();
+  m_ClusterMeans.clear();
+  m_Distributions.clear();
+  m_SteeringLimit = std::numeric_limits<double>::infinity();
+  EvaluatePopulationFully();
+
+  // The hypervolume reference: 1.1 times the worst initial feasible value, so
+  // later fronts are measured against a fixed box.
+  ObjectiveVector worst{ { 0.0, 0.0, 0.0 } };
+  for (std::size_t s = 0; s < m_Population.size(); ++s)
+  {
+    const Fitness f = CurrentFitness(s);
+    if (f.feasible)
+      for (std::size_t m = 0; m < NumberOfObjectives; ++m)
+        worst[m] = std::max(worst[m], f.objectives[m]);
+    InsertIntoArchive(s, f);
+  }
+  for (std::size_t m = 0; m < NumberOfObjectives; ++m)
+    m_Reference[m] = worst[m] > 0.0 ? 1.1 * worst[m] : 1.0;
+  m_History.push_back(Summarise(0));
+}
+
+GenerationRecord
+MoRvGomea::Summarise(std::size_t generation) const
+{
+  GenerationRecord r;
+  r.generation = generation;
+  r.archiveSize = m_Archive->Size();
+  std::vector<ObjectiveVector> points;
+  r.bestGuidance = std::numeric_limits<double>::infinity();
+  for (const auto & e : m_Archive->Entries())
+  {
+    ObjectiveVector p;
+    for (std::size_t m = 0; m < NumberOfObjectives; ++m)
+      p[m] = e.fitness.objectives[m] / m_Reference[m];
+    points.push_back(p);
+    r.bestGuidance = std::min(r.bestGuidance, Value(e.fitness.objectives, Objective::Guidance));
+  }
+  if (points.empty())
+    r.bestGuidance = 0.0;
+  r.hypervolume = Hypervolume(points, { { 1.0, 1.0, 1.0 } });
+  for (std::size_t s = 0; s < m_Population.size(); ++s)
+    if (std::llround(m_Totals[s].sum.folded) == 0)
+      ++r.feasible;
+  double      sum = 0.0;
+  std::size_t n = 0;
+  for (const auto & cluster : m_Distributions)
+    for (const auto & d : cluster)
+    {
+      sum += d.multiplier;
+      ++n;
+    }
+  r.meanMultiplier = n ? sum / static_cast<double>(n) : 1.0;
+  return r;
+}
+
+std::vector<std::size_t>
+MoRvGomea::Select(const std::vector<Fitness> & fitness, RandomGenerator & random) const
+{
+  const std::size_t n = fitness.size();
+  const std::size_t wanted = std::min(
+    n, std::max<std::size_t>(m_Options.numberOfClusters,
+                             static_cast<std::size_t>(std::ceil(m_Options.selectionFraction * static_cast<double>(n)))));
+  const std::vector<std::size_t> ranks = NonDominatedRanks(fitness);
+  std::vector<std::size_t>       order(n);
+  std::iota(order.begin(), order.end(), std::size_t{ 0 });
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return ranks[a] < ranks[b]; });
+  std::vector<std::size_t> selection;
+  std::size_t              i = 0;
+  while (i < n && selection.size() + std::count(ranks.begin(), ranks.end(), ranks[order[i]]) <= wanted)
+  {
+    const std::size_t rank = ranks[order[i]];
+    while (i < n && ranks[order[i]] == rank)
+      selection.push_back(order[i++]);
+  }
+  if (selection.size() < wanted && i < n)
+  {
+    // The front that does not fit: a spread-out subset in normalised objective
+    // space, greedily farthest from what is already selected.
+    std::vector<std::size_t> front;
+    for (std::size_t j = i; j < n && ranks[order[j]] == ranks[order[i]]; ++j)
+      front.push_back(order[j]);
+    ObjectiveVector low, high;
+    low.fill(std::numeric_limits<double>::infinity());
+    high.fill(-std::numeric_limits<double>::infinity());
+    for (std::size_t s : front)
+      for (std::size_t m = 0; m < NumberOfObjectives; ++m)
+      {
+        low[m] = std::min(low[m], fitness[s].objectives[m]);
+        high[m] = std::max(high[m], fitness[s].objectives[m]);
+      }
+    auto norm = [&](std::size_t s) {
+      ObjectiveVector v;
+      for (std::size_t m = 0; m < NumberOfObjectives; ++m)
+        v[m] = Normalised(fitness[s].objectives[m], low[m], high[m]);
+      return v;
+    };
+    std::vector<double> nearest(front.size(), std::numeric_limits<double>::infinity());
+    std::vector<bool>   taken(front.size(), false);
+    std::size_t         pick = static_cast<std::size_t>(random.Uniform() * static_cast<double>(front.size()));
+    while (selection.size() < wanted)
+    {
+      taken[pick] = true;
+      selection.push_back(front[pick]);
+      const ObjectiveVector p = norm(front[pick]);
+      double                far = -1.0;
+      for (std::size_t j = 0; j < front.size(); ++j)
+        if (!taken[j])
+        {
+          nearest[j] = std::min(nearest[j], SquaredDistance(p, norm(front[j])));
+          if (nearest[j] > far)
+          {
+            far = nearest[j];
+            pick = j;
+          }
+        }
+      if (far < 0.0)
+        break;
+    }
+  }
+  return selection;
+}
+
+std::vector<MoRvGomea::ClusterModel>
+MoRvGomea::BuildClusters(const std::vector<std::size_t> & selection, const std::vector<Fitness> & fitness,
+                         RandomGenerator & random)
+{
+  // Normalised objective space of the selection.
+  ObjectiveVector low, high;
+  low.fill(std::numeric_limits<double>::infinity());
+  high.fill(-std::numeric_limits<double>::infinity());
+  for (std::size_t s : selection)
+    for (std::size_t m = 0; m < NumberOfObjectives; ++m)
+    {
+      low[m] = std::min(low[m], fitness[s].objectives[m]);
+      high[m] = std::max(high[m], fitness[s].objectives[m]);
+    }
+  auto norm = [&](std::size_t s) {
+    ObjectiveVector v;
+    for (std::size_t m = 0; m < NumberOfObjectives; ++m)
+      v[m] = Normalised(fitness[s].objectives[m], low[m], high[m]);
+    return v;
+  };
+  std::vector<ObjectiveVector> points;
+  for (std::size_t s : selection)
+    points.push_back(norm(s));
+
+  const std::size_t k = std::min(m_Options.numberOfClusters, selection.size());
+  const std::size_t clusterSize =
+    std::min(selection.size(), std::max<std::size_t>(2, (2 * selection.size() + k - 1) / k));
+
+  // k-leader-means: spread-out leaders, then a few k-means steps.
+  std::vector<ObjectiveVector> means;
+  std::vector<double>          nearest(points.size(), std::numeric_limits<double>::infinity());
+  std::size_t leader = static_cast<std::size_t>(random.Uniform() * static_cast<double>(points.size()));
+  while (means.size() < k)
+  {
+    means.push_back(points[leader]);
+    double far = -1.0;
+    for (std::size_t j = 0; j < points.size(); ++j)
+    {
+      nearest[j] = std::min(nearest[j], SquaredDistance(points[j], means.back()));
+      if (nearest[j] > far)
+      {
+        far = nearest[j];
+        leader = j;
+      }
+    }
+  }
+  for (std::size_t iteration = 0; iteration < KMeansIterations; ++iteration)
+  {
+    std::vector<ObjectiveVector> sums(k, ObjectiveVector{ { 0.0, 0.0, 0.0 } });
+    std::vector<std::size_t>     counts(k, 0);
+    for (const auto & p : points)
+    {
+      std::size_t best = 0;
+      for (std::size_t c = 1; c < k; ++c)
+        if (SquaredDistance(p, means[c]) < SquaredDistance(p, means[best]))
+          best = c;
+      for (std::size_t m = 0; m < NumberOfObjectives; ++m)
+        sums[best][m] += p[m];
+      ++counts[best];
+    }
+    for (std::size_t c = 0; c < k; ++c)
+      if (counts[c])
+        for (std::size_t m = 0; m < NumberOfObjectives; ++m)
+          means[c][m] = sums[c][m] / static_cast<double>(counts[c]);
+  }
+
+  std::vector<ClusterModel> clusters(k + NumberOfObjectives);
+  std::vector<std::size_t>  order(points.size());
+  for (std::size_t c = 0; c < k; ++c)
+  {
+    // The clusterSize selected solutions nearest the mean (clusters overlap).
+    std::iota(order.begin(), order.end(), std::size_t{ 0 });
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      return SquaredDistance(points[a], means[c]) < SquaredDistance(points[b], means[c]);
+    });
+    clusters[c].mean = means[c];
+    for (std::size_t j = 0; j < clusterSize; ++j)
+      clusters[c].members.push_back(selection[order[j]]);
+  }
+  // Single-objective clusters: the best of the selection in one objective, to
+  // push the extremes of the front outwards. Objectives without spread (e.g.
+  // guidance when disabled) get none.
+  for (std::size_t m = 0; m < NumberOfObjectives; ++m)
+  {
+    ClusterModel & cluster = clusters[k + m];
+    cluster.singleObjective = static_cast<int>(m);
+    if (!(high[m] > low[m]))
+      continue;
+    std::iota(order.begin(), order.end(), std::size_t{ 0 });
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      const Fitness & fa = fitness[selection[a]];
+      const Fitness & fb = fitness[selection[b]];
+      if (fa.feasible != fb.feasible)
+        return fa.feasible;
+      return fa.objectives[m] < fb.objectives[m];
+    });
+    const std::size_t size = std::min(clusterSize, std::max<std::size_t>(2, selection.size() / k));
+    ObjectiveVector   mean{ { 0.0, 0.0, 0.0 } };
+    for (std::size_t j = 0; j < size; ++j)
+    {
+      cluster.members.push_back(selection[order[j]]);
+      for (std::size_t q = 0; q < NumberOfObjectives; ++q)
+        mean[q] += points[order[j]][q] / static_cast<double>(size);
+    }
+    cluster.mean = mean;
+  }
+
+  // Carry the adaptive state over: regular clusters from the nearest previous
+  // regular cluster, single-objective ones from their predecessor.
+  const std::size_t                           elements = m_Parallel.elements.size();
+  std::vector<std::vector<DistributionState>> states(clusters.size(),
+                                                     std::vector<DistributionState>(elements));
+  const std::size_t previousRegular =
+    m_ClusterMeans.size() >= NumberOfObjectives ? m_ClusterMeans.size() - NumberOfObjectives : 0;
+  for (std::size_t c = 0; c < clusters.size(); ++c)
+  {
+    if (m_Distributions.empty())
+      break;
+    std::size_t from = c;
+    if (c < k)
+    {
+      if (previousRegular == 0)
+        continue;
+      from = 0;
+      for (std::size_t p = 1; p < previousRegular; ++p)
+        if (SquaredDistance(clusters[c].mean, m_ClusterMeans[p]) < SquaredDistance(clusters[c].mean, m_ClusterMeans[from]))
+          from = p;
+    }
+    else
+      from = previousRegular + (c - k);
+    if (from < m_Distributions.size())
+      states[c] = m_Distributions[from];
+  }
+  m_Distributions = std::move(states);
+  m_ClusterMeans.clear();
+  for (const auto & c : clusters)
+    m_ClusterMeans.push_back(c.mean);
+
+  // Every solution is varied with the model of the cluster whose mean is
+  // nearest to it.
+  for (std::size_t s = 0; s < m_Population.size(); ++s)
+  {
+    const ObjectiveVector p = norm(s);
+    std::size_t           best = clusters.size();
+    for (std::size_t c = 0; c < clusters.size(); ++c)
+      if (!clusters[c].members.empty() &&
+          (best == clusters.size() || SquaredDistance(p, clusters[c].mean) < SquaredDistance(p, clusters[best].mean)))
+        best = c;
+    clusters[best].population.push_back(s);
+  }
+  return clusters;
+}
+
+void
+MoRvGomea::EstimateDistributions(std::vector<ClusterModel> & clusters) const
+{
+  for (auto & cluster : clusters)
+  {
+    if (cluster.members.empty() || cluster.population.empty())
+      continue;
+    cluster.means.resize(m_Parallel.elements.size());
+    cluster.cholesky.resize(m_Parallel.elements.size());
+    const double count = static_cast<double>(cluster.members.size());
+    for (std::size_t e = 0; e < m_Parallel.elements.size(); ++e)
+    {
+      const FosElement &  element = m_Parallel.elements[e];
+      const std::size_t   n = 6 * element.points.size();
+      std::vector<double> x(n), mean(n, 0.0), covariance(n * n, 0.0);
+      std::vector<double> all(n * cluster.members.size());
+      for (std::size_t j = 0; j < cluster.members.size(); ++j)
+      {
+        Gather(m_Population[cluster.members[j]], element, all.data() + j * n);
+        for (std::size_t i = 0; i < n; ++i)
+          mean[i] += all[j * n + i] / count;
+      }
+      for (std::size_t j = 0; j < cluster.members.size(); ++j)
+      {
+        const double * v = all.data() + j * n;
+        for (std::size_t a = 0; a < n; ++a)
+          for (std::size_t b = 0; b <= a; ++b)
+            covariance[a * n + b] += (v[a] - mean[a]) * (v[b] - mean[b]) / count;
+      }
+      // Few members for many variables give a singular estimate that only
+      // samples the members' span: shrink the off-diagonal part towards 0 by
+      // the ratio of variables to members (the full estimate for large clusters).
+      const double shrink = std::min(1.0, static_cast<double>(n) / count);
+      for (std::size_t a = 0; a < n; ++a)
+        for (std::size_t b = 0; b < a; ++b)
+          covariance[b * n + a] = covariance[a * n + b] *= (1.0 - shrink);
+      cluster.means[e] = std::move(mean);
+      cluster.cholesky[e] = RegularisedCholesky(std::move(covariance), n);
+    }
+  }
+}
+
+std::size_t
+MoRvGomea::ProcessCandidates(std::vector<Candidate> & candidates, GenerationRecord & record)
+{
+  const auto &   tets = m_Topology.Tetrahedra();
+  RepairOptions  repairOptions;
+  // 1. Folds: checked (and repaired) before any costly evaluation; a folded
+  //    candidate cannot replace a fold-free parent.
+  std::vector<PartialCandidate> batch;
+  std::vector<std::size_t>      batchIndex;
+  std::vector<Vec3>             scratch;
+  for (std::size_t i = 0; i < candidates.size(); ++i)
+  {
+    Candidate &        c = candidates[i];
+    const FosElement & element = m_Parallel.elements[c.element];
+    const DualMesh &   parent = m_Population[c.solution];
+    ++record.candidates;
+    for (int side = 0; side < 2; ++side)
+    {
+      const std::vector<Vec3> & from = side == 0 ? parent.source : parent.target;
+      std::vector<Vec3> &       moved = side == 0 ? c.source : c.target;
+      bool                      folded = false;
+      for (std::uint32_t t : element.dependentTetrahedra)
+      {
+        Corners corners;
+        for (int v = 0; v < 4; ++v)
+        {
+          const auto it = std::find(element.points.begin(), element.points.end(), tets[t][v]);
+          corners[v] = it == element.points.end() ? from[tets[t][v]] : moved[it - element.points.begin()];
+        }
+        bool f = false;
+        m_Constraint.TetrahedronViolation(t, corners[0], corners[1], corners[2], corners[3], f);
+        if (f)
+        {
+          folded = true;
+          break;
+        }
+      }
+      if (folded && !c.folded)
+        ++record.folded;
+      if (folded && m_Options.repair)
+      {
+        scratch = from;
+        for (std::size_t k = 0; k < element.points.size(); ++k)
+          scratch[element.points[k]] = moved[k];
+        RandomGenerator random(HashCombine(c.seed, static_cast<std::uint64_t>(side)));
+        const RepairResult r =
+          RepairPoints(scratch, &element.points, &element.dependentTetrahedra, m_Base, m_Constraint, random, repairOptions);
+        for (std::size_t k = 0; k < element.points.size(); ++k)
+          moved[k] = scratch[element.points[k]];
+        folded = !r.after.Feasible();
+        if (!folded)
+          ++record.repaired;
+      }
+      c.folded = c.folded || folded;
+    }
+    if (c.folded && std::llround(m_Totals[c.solution].sum.folded) == 0)
+      continue;
+    c.values.resize(element.dependentTetrahedra.size());
+    PartialCandidate p;
+    p.parent = &parent;
+    p.element = &element;
+    p.source = c.source.data();
+    p.target = c.target.data();
+    p.values = c.values.data();
+    batch.push_back(p);
+    batchIndex.push_back(i);
+    record.tetrahedronEvaluations += static_cast<double>(element.dependentTetrahedra.size());
+  }
+
+  // 2. Evaluation of the whole batch at once (the backend's unit of work).
+  m_Backend.EvaluatePartials(batch);
+
+  // 3. Acceptance in a fixed order; candidates of one solution touch disjoint
+  //    tetrahedra, so each sees the totals left by the ones before it.
+  std::size_t accepted = 0;
+  for (std::size_t i : batchIndex)
+  {
+    Candidate &        c = candidates[i];
+    const FosElement & element = m_Parallel.elements[c.element];
+    const std::size_t  s = c.solution;
+    ObjectiveTotals    totals = m_Totals[s];
+    for (std::size_t k = 0; k < element.dependentTetrahedra.size(); ++k)
+    {
+      totals.Add(m_TetValues[s][element.dependentTetrahedra[k]], -1.0);
+      totals.Add(c.values[k]);
+    }
+    const Fitness now = CurrentFitness(s);
+    const Fitness next = Steered(totals.ToFitness(m_Topology.NumberOfTetrahedra()));
+    bool          accept = false;
+    if (c.forced)
+      accept = ConstraintDominates(next, now);
+    else if (c.singleObjective >= 0)
+    {
+      const auto m = static_cast<std::size_t>(c.singleObjective);
+      if (next.feasible != now.feasible)
+        accept = next.feasible;
+      else if (!next.feasible)
+        accept = next.constraint < now.constraint;
+      else
+        accept = next.objectives[m] < now.objectives[m];
+    }
+    else
+      accept = ConstraintDominates(next, now) || m_Archive->Accepts(next);
+    if (!accept)
+      continue;
+    DualMesh & solution = m_Population[s];
+    for (std::size_t k = 0; k < element.points.size(); ++k)
+    {
+      solution.source[element.points[k]] = c.source[k];
+      solution.target[element.points[k]] = c.target[k];
+    }
+    for (std::size_t k = 0; k < element.dependentTetrahedra.size(); ++k)
+      m_TetValues[s][element.dependentTetrahedra[k]] = c.values[k];
+    m_Totals[s] = totals;
+    m_Ids[s] = m_NextId++;
+    InsertIntoArchive(s, next);
+    c.accepted = true;
+    ++accepted;
+  }
+  record.accepted += accepted;
+  return accepted;
+}
+
+void
+MoRvGomea::ForcedImprovement(std::size_t s, int singleObjective, RandomGenerator & random, GenerationRecord & record)
+{
+  const auto & entries = m_Archive->Entries();
+  if (entries.empty())
+    return;
+  std::size_t donor = static_cast<std::size_t>(random.Uniform() * static_cast<double>(entries.size()));
+  if (singleObjective >= 0)
+    for (std::size_t j = 0; j < entries.size(); ++j)
+      if (entries[j].fitness.objectives[singleObjective] < entries[donor].fitness.objectives[singleObjective])
+        donor = j;
+  const DualMesh donorMesh = entries[donor].solution; // a copy: accepting may change the archive
+  ++record.forcedImprovements;
+  std::size_t accepted = 0;
+  for (const auto & group : m_Parallel.groups)
+  {
+    std::vector<Candidate> candidates;
+    for (std::uint32_t e : group)
+    {
+      Candidate c;
+      c.solution = s;
+      c.element = e;
+      c.forced = true;
+      c.seed = random.NextU64();
+      for (std::uint32_t p : m_Parallel.elements[e].points)
+      {
+        c.source.push_back(donorMesh.source[p]);
+        c.target.push_back(donorMesh.target[p]);
+      }
+      candidates.push_back(std::move(c));
+    }
+    accepted += ProcessCandidates(candidates, record);
+  }
+  if (accepted == 0)
+  {
+    // Nothing helped piecewise: take the donor over whole.
+    m_Population[s] = donorMesh;
+    m_Ids[s] = entries[donor].id;
+    m_Backend.EvaluateSolutions({ &m_Population[s] }, { &m_TetValues[s] });
+    m_Totals[s] = ObjectiveTotals{};
+    for (const auto & v : m_TetValues[s])
+      m_Totals[s].Add(v);
+    record.tetrahedronEvaluations += static_cast<double>(m_Topology.NumberOfTetrahedra());
+  }
+}
+
+void
+MoRvGomea::RunGeneration()
+{
+  if (m_Population.empty())
+    throw Error("optimiser: Initialize() must come before RunGeneration()");
+  if (Finished())
+    throw Error("optimiser: all " + std::to_string(m_Options.generations) + " generations have run");
+  const auto       start = std::chrono::steady_clock::now();
+  GenerationRecord record;
+  RandomGenerator  random(HashCombine(m_Options.seed, static_cast<std::uint64_t>(m_Generation) + 1));
+
+  // Adaptive steering: after the exploration period only guidance values up
+  // to threshold x the archive's best are kept (a hard constraint).
+  if (m_Options.steeringEnabled && m_Generation >= m_Options.steeringStart && m_Archive->Size() > 0)
+  {
+    double best = std::numeric_limits<double>::infinity();
+    for (const auto & e : m_Archive->Entries())
+      best = std::min(best, Value(e.fitness.objectives, Objective::Guidance));
+    m_SteeringLimit = m_Options.steeringThreshold * best;
+    const double limit = m_SteeringLimit;
+    m_Archive->RemoveIf(
+      [limit](const ArchiveEntry & e) { return Value(e.fitness.objectives, Objective::Guidance) > limit; });
+  }
+
+  const std::vector<Fitness>     fitness = PopulationFitness();
+  const std::vector<std::size_t> selection = Select(fitness, random);
+  std::vector<ClusterModel>      clusters = BuildClusters(selection, fitness, random);
+  EstimateDistributions(clusters);
+
+  std::vector<std::size_t> groupOrder(m_Parallel.groups.size());
+  std::iota(groupOrder.begin(), groupOrder.end(), std::size_t{ 0 });
+  for (std::size_t i = groupOrder.size(); i > 1; --i)
+    std::swap(groupOrder[i - 1], groupOrder[static_cast<std::size_t>(random.Uniform() * static_cast<double>(i))]);
+
+  const std::size_t elements = m_Parallel.elements.size();
+  std::vector<bool> improved(m_Population.size(), false);
+  std::vector<int>  solutionCluster(m_Population.size(), -1);
+  // Per cluster and element: sum of accepted samples, for the ratio test.
+  std::vector<std::vector<std::vector<double>>> acceptedSum(clusters.size(), std::vector<std::vector<double>>(elements));
+  std::vector<std::vector<std::size_t>>         acceptedCount(clusters.size(), std::vector<std::size_t>(elements, 0));
+  const double n = static_cast<double>(m_Population.size());
+  const double amsFraction = 0.5 * m_Options.selectionFraction * n / std::max(1.0, n - 1.0);
+
+  for (std::size_t c = 0; c < clusters.size(); ++c)
+  {
+    ClusterModel & cluster = clusters[c];
+    if (cluster.population.empty() || cluster.means.empty())
+      continue;
+    std::vector<std::size_t> members = cluster.population;
+    for (std::size_t i = members.size(); i > 1; --i)
+      std::swap(members[i - 1], members[static_cast<std::size_t>(random.Uniform() * static_cast<double>(i))]);
+    const auto amsCount = static_cast<std::size_t>(amsFraction * static_cast<double>(members.size()));
+    for (std::size_t s : members)
+      solutionCluster[s] = cluster.singleObjective;
+
+    for (std::size_t g : groupOrder)
+    {
+      std::vector<Candidate> candidates;
+      for (std::size_t j = 0; j < members.size(); ++j)
+        for (std::uint32_t e : m_Parallel.groups[g])
+        {
+          const FosElement &        element = m_Parallel.elements[e];
+          const std::size_t         dim = 6 * element.points.size();
+          const std::vector<double> & mean = cluster.means[e];
+          const std::vector<double> & l = cluster.cholesky[e];
+          const DistributionState &   state = m_Distributions[c][e];
+          std::vector<double>         z(dim), x(dim);
+          for (auto & v : z)
+            v = random.Normal();
+          const double scale = std::sqrt(state.multiplier);
+          for (std::size_t a = 0; a < dim; ++a)
+          {
+            double v = 0.0;
+            for (std::size_t b = 0; b <= a; ++b)
+              v += l[a * dim + b] * z[b];
+            x[a] = mean[a] + scale * v;
+          }
+          if (j < amsCount && state.previousMean.size() == dim)
+            for (std::size_t a = 0; a < dim; ++a)
+              x[a] += AmsDelta * state.multiplier * (mean[a] - state.previousMean[a]);
+          Candidate cand;
+          cand.solution = members[j];
+          cand.element = e;
+          cand.cluster = c;
+          cand.singleObjective = cluster.singleObjective;
+          cand.seed = random.NextU64();
+          for (std::size_t k = 0; k < element.points.size(); ++k)
+          {
+            const std::uint32_t p = element.points[k];
+            cand.source.push_back(
+              ProjectToDomain({ { x[6 * k], x[6 * k + 1], x[6 * k + 2] } }, m_Base.pins[p], m_Base.domain));
+            cand.target.push_back(
+              ProjectToDomain({ { x[6 * k + 3], x[6 * k + 4], x[6 * k + 5] } }, m_Base.pins[p], m_Base.domain));
+          }
+          cand.sample = std::move(x);
+          candidates.push_back(std::move(cand));
+        }
+      ProcessCandidates(candidates, record);
+      for (const Candidate & cand : candidates)
+        if (cand.accepted)
+        {
+          improved[cand.solution] = true;
+          auto & sum = acceptedSum[c][cand.element];
+          sum.resize(cand.sample.size(), 0.0);
+          for (std::size_t a = 0; a < sum.size(); ++a)
+            sum[a] += cand.sample[a];
+          ++acceptedCount[c][cand.element];
+        }
+    }
+  }
+
+  // Distribution multipliers (adaptive variance scaling with the
+  // standard-deviation-ratio test and the no-improvement stretch).
+  for (std::size_t c = 0; c < clusters.size(); ++c)
+  {
+    if (clusters[c].means.empty() || clusters[c].population.empty())
+      continue;
+    for (std::size_t e = 0; e < elements; ++e)
+    {
+      DistributionState & state = m_Distributions[c][e];
+      const std::size_t   dim = clusters[c].means[e].size();
+      const std::size_t   maxStretch = 25 + dim;
+      if (acceptedCount[c][e] > 0)
+      {
+        // SDR: the accepted samples' mean in standard deviations of the model.
+        std::vector<double> d(dim), y(dim);
+        for (std::size_t a = 0; a < dim; ++a)
+          d[a] = acceptedSum[c][e][a] / static_cast<double>(acceptedCount[c][e]) - clusters[c].means[e][a];
+        const auto & l = clusters[c].cholesky[e];
+        double       ratio = 0.0;
+        for (std::size_t a = 0; a < dim; ++a)
+        {
+          double v = d[a];
+          for (std::size_t b = 0; b < a; ++b)
+            v -= l[a * dim + b] * y[b];
+          y[a] = v / l[a * dim + a];
+          ratio = std::max(ratio, std::abs(y[a]));
+        }
+        state.noImprovementStretch = 0;
+        if (state.multiplier < 1.0)
+          state.multiplier = 1.0;
+        if (ratio > StandardDeviationRatioThreshold)
+          state.multiplier = std::min(MultiplierMaximum, state.multiplier * MultiplierIncrease);
+      }
+      else
+      {
+        if (state.multiplier <= 1.0)
+          ++state.noImprovementStretch;
+        if (state.multiplier > 1.0 || state.noImprovementStretch >= maxStretch)
+          state.multiplier *= MultiplierDecrease;
+        if (state.multiplier < 1.0 && state.noImprovementStretch < maxStretch)
+          state.multiplier = 1.0;
+      }
+      state.previousMean = clusters[c].means[e];
+    }
+  }
+
+  // Forced improvements for solutions stalled too long.
+  const std::size_t maxStretch = 25 + 6 * 2;
+  for (std::size_t s = 0; s < m_Population.size(); ++s)
+  {
+    m_NoImprovement[s] = improved[s] ? 0 : m_NoImprovement[s] + 1;
+    if (m_NoImprovement[s] > maxStretch)
+    {
+      ForcedImprovement(s, solutionCluster[s], random, record);
+      m_NoImprovement[s] = 0;
+    }
+  }
+
+  ++m_Generation;
+  if (m_Options.fullEvaluationInterval > 0 && m_Generation % m_Options.fullEvaluationInterval == 0)
+  {
+    EvaluatePopulationFully();
+    record.tetrahedronEvaluations += n * static_cast<double>(m_Topology.NumberOfTetrahedra());
+  }
+  GenerationRecord summary = Summarise(m_Generation);
+  summary.accepted = record.accepted;
+  summary.repaired = record.repaired;
+  summary.candidates = record.candidates;
+  summary.folded = record.folded;
+  summary.forcedImprovements = record.forcedImprovements;
+  summary.tetrahedronEvaluations = record.tetrahedronEvaluations;
+  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  m_History.push_back(summary);
+}
+
+void
+MoRvGomea::Run(const std::function<void(const GenerationRecord &)> & onGeneration)
+{
+  while (!Finished())
+  {
+    RunGeneration();
+    if (onGeneration)
+      onGeneration(m_History.back());
+  }
+}
+} // namespace morea

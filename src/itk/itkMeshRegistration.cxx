@@ -1,0 +1,68 @@
+#include "itkMeshRegistration.h"
+
+#include "itkObjectiveData.h"
+#include "morea/EvaluationBackend.h"
+#include "morea/FoldConstraint.h"
+#include "morea/InitialPopulation.h"
+#include "morea/ParameterSet.h"
+#include "morea/TetrahedronObjectives.h"
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <thread>
+
+namespace itk
+{
+namespace morea
+{
+MeshRegistrationResult
+RegisterMeshes(const RegistrationProblem & problem, const ::morea::ParameterSet & parameters,
+               const MeshRegistrationOptions & options)
+{
+  using Clock = std::chrono::steady_clock;
+  auto                   start = Clock::now();
+  MeshRegistrationResult result;
+  result.model = BuildMeshModel(problem, parameters);
+  const MeshModel &             model = result.model;
+  const ::morea::ObjectiveData  data = BuildObjectiveData(problem, model, parameters);
+  const ::morea::FoldConstraint constraint(model.topology, model.base.points);
+  const ::morea::TetrahedronEvaluator evaluator(model.topology, constraint, model.elasticity, data);
+  auto backend = ::morea::CreateCpuEvaluationBackend(evaluator, options.threads);
+  result.backend = backend->Name();
+  result.threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+  result.secondsModel = std::chrono::duration<double>(Clock::now() - start).count();
+
+  start = Clock::now();
+  const ::morea::GomeaOptions gomea = ::morea::GomeaOptions::FromParameters(parameters);
+  ::morea::MoRvGomea optimiser(model.base, model.topology, model.parallel, constraint, *backend, gomea);
+  if (options.resume && !options.checkpointPath.empty() && std::filesystem::exists(options.checkpointPath))
+  {
+    optimiser.LoadCheckpoint(options.checkpointPath);
+    result.resumedAtGeneration = optimiser.Generation();
+  }
+  else
+    optimiser.Initialize(::morea::GenerateInitialPopulation(
+      model.base, constraint, gomea.populationSize, gomea.seed,
+      ::morea::InitialPopulationOptions::FromParameters(parameters)));
+  while (!optimiser.Finished())
+  {
+    optimiser.RunGeneration();
+    const bool last = optimiser.Finished();
+    if (!options.checkpointPath.empty() &&
+        (last || (options.checkpointInterval > 0 && optimiser.Generation() % options.checkpointInterval == 0)))
+      optimiser.SaveCheckpoint(options.checkpointPath);
+    if (options.onGeneration)
+      options.onGeneration(optimiser.History().back(), gomea.generations);
+  }
+  result.secondsOptimisation = std::chrono::duration<double>(Clock::now() - start).count();
+  result.history = optimiser.History();
+  for (const auto & e : optimiser.Archive().Entries())
+    result.front.push_back({ e.id, e.fitness, e.solution });
+  std::stable_sort(result.front.begin(), result.front.end(), [](const FrontSolution & a, const FrontSolution & b) {
+    return a.fitness.objectives[2] < b.fitness.objectives[2];
+  });
+  return result;
+}
+} // namespace morea
+} // namespace itk

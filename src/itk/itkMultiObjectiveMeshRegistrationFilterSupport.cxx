@@ -1,0 +1,208 @@
+#include "itkMultiObjectiveMeshRegistrationFilterSupport.h"
+
+#include "morea/Error.h"
+#include "morea/ParameterSet.h"
+#include "morea/ParetoFront.h"
+
+#include <algorithm>
+#include <ostream>
+#include <sstream>
+
+namespace itk
+{
+namespace morea
+{
+namespace
+{
+const char * const SelectionHelp = "best-guidance, knee, weighted:a:b:c, nearest:m:i:g, all";
+
+::morea::ObjectiveVector
+ParseTriple(const std::string & item, const std::string & text)
+{
+  std::vector<std::string> parts;
+  std::istringstream       in(text);
+  for (std::string part; std::getline(in, part, ':');)
+    parts.push_back(part);
+  ::morea::ObjectiveVector v{};
+  try
+  {
+    if (parts.size() != 3)
+      throw std::invalid_argument(text);
+    for (std::size_t m = 0; m < 3; ++m)
+    {
+      std::size_t used = 0;
+      v[m] = std::stod(parts[m], &used);
+      if (used != parts[m].size())
+        throw std::invalid_argument(parts[m]);
+    }
+  }
+  catch (const std::exception &)
+  {
+    throw ::morea::Error("selection: '" + item + "' needs three numbers (magnitude:intensity:guidance)");
+  }
+  return v;
+}
+
+/** Walks the selection; `add` gets each choice. With an empty `objectives`
+ *  only the syntax is checked (no index is computed). */
+void
+ForEachChoice(const std::string & selection, const std::vector<::morea::ObjectiveVector> & objectives,
+              const std::function<void(const std::string &, std::size_t)> & add)
+{
+  const bool check = objectives.empty();
+  bool       any = false;
+  for (const std::string & item : ::morea::ParseNameList(selection))
+  {
+    any = true;
+    if (item == "best-guidance")
+    {
+      if (!check)
+        add("best_guidance", ::morea::SelectBestGuidance(objectives));
+    }
+    else if (item == "knee")
+    {
+      if (!check)
+        add("knee", ::morea::SelectKnee(objectives));
+    }
+    else if (item == "all")
+    {
+      for (std::size_t i = 0; i < objectives.size(); ++i)
+        add({}, i); // labelled by the caller, which knows the ids
+    }
+    else if (item.rfind("weighted:", 0) == 0)
+    {
+      const auto weights = ParseTriple(item, item.substr(9));
+      if (!check)
+        add("weighted", ::morea::SelectWeighted(objectives, weights));
+    }
+    else if (item.rfind("nearest:", 0) == 0)
+    {
+      const auto point = ParseTriple(item, item.substr(8));
+      if (!check)
+        add("nearest", ::morea::SelectNearest(objectives, point));
+    }
+    else
+      throw ::morea::Error("selection: unknown choice '" + item + "' (" + SelectionHelp + ")");
+  }
+  if (!any)
+    throw ::morea::Error(std::string("selection: no solution named (") + SelectionHelp + ")");
+}
+} // namespace
+
+bool
+operator==(const ApproximationSolution & a, const ApproximationSolution & b)
+{
+  return a.id == b.id && a.objectives == b.objectives && a.constraint == b.constraint;
+}
+
+bool
+operator!=(const ApproximationSolution & a, const ApproximationSolution & b)
+{
+  return !(a == b);
+}
+
+std::ostream &
+operator<<(std::ostream & os, const ApproximationSolution & s)
+{
+  return os << "id " << s.id << ": magnitude " << s.objectives[0] << ", intensity " << s.objectives[1]
+            << ", guidance " << s.objectives[2] << ", constraint " << s.constraint;
+}
+
+ApproximationSet
+ToApproximationSet(const std::vector<FrontSolution> & front)
+{
+  ApproximationSet set;
+  set.reserve(front.size());
+  for (const auto & s : front)
+    set.push_back({ s.id, s.fitness.objectives, s.fitness.constraint });
+  return set;
+}
+
+void
+CheckSolutionSelection(const std::string & selection)
+{
+  ForEachChoice(selection, {}, [](const std::string &, std::size_t) {});
+}
+
+std::vector<SolutionChoice>
+SelectSolutions(const ApproximationSet & set, const std::string & selection)
+{
+  CheckSolutionSelection(selection);
+  if (set.empty())
+    throw ::morea::Error("the approximation set is empty: no fold-free solution was found");
+  std::vector<::morea::ObjectiveVector> objectives;
+  for (const auto & s : set)
+    objectives.push_back(s.objectives);
+  std::vector<SolutionChoice> chosen;
+  ForEachChoice(selection, objectives, [&](const std::string & label, std::size_t index) {
+    const std::string name = label.empty() ? "solution_" + std::to_string(set[index].id) : label;
+    // One output pair per label: "knee,knee" or "all,all" do not duplicate.
+    if (std::none_of(chosen.begin(), chosen.end(), [&](const SolutionChoice & c) { return c.label == name; }))
+      chosen.push_back({ name, index });
+  });
+  return chosen;
+}
+
+MultiObjectiveRegistrationRun
+RunMultiObjectiveRegistration(const RegistrationProblem & problem, const ::morea::ParameterSet & parameters,
+                              const MeshRegistrationOptions & options, const std::string & selection,
+                              const std::function<void(double)> & progress)
+{
+  const auto report = [&](double fraction) {
+    if (progress)
+      progress(fraction);
+  };
+  // Cheap checks first, so that a typo does not surface after the whole run.
+  CheckSolutionSelection(selection);
+  problem.Validate();
+
+  MultiObjectiveRegistrationRun run;
+  PreprocessResult preprocessed = Preprocess(problem, PreprocessOptions::FromParameters(parameters));
+  run.preprocessedFixedImage = preprocessed.problem.fixedImage;
+  run.preprocessedMovingImage = preprocessed.problem.movingImage;
+  run.rigidTransform = preprocessed.rigidTransform;
+  run.preprocessReport = preprocessed.report;
+  report(PreprocessingProgressShare);
+
+  MeshRegistrationOptions registration = options;
+  registration.onGeneration = [&](const ::morea::GenerationRecord & record, std::size_t generations) {
+    const double done = generations > 0 ? static_cast<double>(record.generation) / static_cast<double>(generations) : 1.0;
+    report(PreprocessingProgressShare + (OptimisationProgressEnd - PreprocessingProgressShare) * std::min(1.0, done));
+    if (options.onGeneration)
+      options.onGeneration(record, generations);
+  };
+  const MeshRegistrationResult result = RegisterMeshes(preprocessed.problem, parameters, registration);
+  run.approximationSet = ToApproximationSet(result.front);
+  run.history = result.history;
+  run.backend = result.backend;
+  run.resumedAtGeneration = result.resumedAtGeneration;
+  report(OptimisationProgressEnd);
+
+  const auto chosen = SelectSolutions(run.approximationSet, selection);
+  for (std::size_t i = 0; i < chosen.size(); ++i)
+  {
+    const MeshFields fields = RasterizeSolution(result.model.topology, result.front[chosen[i].index].mesh,
+                                                preprocessed.problem.fixedImage, preprocessed.problem.movingImage);
+    run.selected.push_back({ chosen[i], fields.fixedToMovingTransform, fields.movingToFixedTransform });
+    report(OptimisationProgressEnd +
+           (1.0 - OptimisationProgressEnd) * static_cast<double>(i + 1) / static_cast<double>(chosen.size()));
+  }
+  return run;
+}
+
+void
+PrintParameters(std::ostream & os, const ::morea::ParameterSet & parameters, Indent indent)
+{
+  // The main run keys always, the rest only when set: all ~50 keys would bury them.
+  static const char * const always[] = { "ea_num_generations", "ea_population_size", "morea_mesh_num_points",
+                                         "seed" };
+  std::istringstream lines(parameters.ToToml());
+  for (std::string line; std::getline(lines, line);)
+  {
+    const std::string key = line.substr(0, line.find(" = "));
+    if (parameters.IsExplicit(key) || std::find(std::begin(always), std::end(always), key) != std::end(always))
+      os << indent << line << std::endl;
+  }
+}
+} // namespace morea
+} // namespace itk

@@ -1,0 +1,357 @@
+// Tests of morea::ElitistArchive: non-domination, the capacity kept by
+// discretising objective space, checkpoint restore and the stored payload.
+// Core tests: no ITK.
+#include "morea/ElitistArchive.h"
+#include "morea/Error.h"
+#include "morea/Random.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <vector>
+
+namespace
+{
+using morea::ElitistArchive;
+using morea::Fitness;
+using morea::ObjectiveVector;
+
+Fitness
+Feasible(double a, double b, double c)
+{
+  return Fitness{ { { a, b, c } }, true, 0.0 };
+}
+
+/** A payload that tells which solution it belongs to. */
+morea::DualMesh
+PayloadOf(std::uint64_t id)
+{
+  const double x = static_cast<double>(id);
+  return morea::DualMesh{ { { { x, x + 0.25, -x } }, { { 1.0, 2.0, 3.0 } } }, { { { -x, x * 2.0, 0.5 } } } };
+}
+
+/** The archive's grid convention (ElitistArchive.cxx): cells centred on
+ *  multiples of the width; a width of 0 leaves the objective out. */
+std::array<double, 3>
+CellOf(const ObjectiveVector & x, const ObjectiveVector & widths)
+{
+  std::array<double, 3> cell{};
+  for (int j = 0; j < 3; ++j)
+    cell[j] = widths[j] > 0.0 ? std::floor(x[j] / widths[j] + 0.5) : 0.0;
+  return cell;
+}
+
+/** Squared distance from the cell's lower corner, in cell widths. */
+double
+DistanceToCellCorner(const ObjectiveVector & x, const ObjectiveVector & widths)
+{
+  const auto cell = CellOf(x, widths);
+  double     d = 0.0;
+  for (int j = 0; j < 3; ++j)
+    if (widths[j] > 0.0)
+      d += std::pow(x[j] / widths[j] + 0.5 - cell[j], 2);
+  return d;
+}
+
+/** A random candidate at progress t in [0, 1). Mostly on the surface
+ *  x * y * z = 1 (shifted by `shift`), whose points are all mutually
+ *  non-dominated, over a patch that grows with t, so the archive keeps
+ *  overflowing and being re-discretised; the rest a little behind the surface
+ *  (mostly dominated); some infeasible. */
+Fitness
+RandomCandidate(morea::RandomGenerator & random, double t, double shift)
+{
+  const double radius = 0.1 + 1.4 * t; // in log space
+  const double u = random.Uniform(-radius, radius);
+  const double v = random.Uniform(-radius, radius);
+  Fitness      f;
+  f.objectives = { { std::exp(u) + shift, std::exp(v) + shift, std::exp(-u - v) + shift } };
+  if (random.Uniform() < 0.3)
+    for (double & x : f.objectives)
+      x += random.Uniform(0.0, 0.3);
+  if (random.Uniform() < 0.1)
+  {
+    f.feasible = false;
+    f.constraint = random.Uniform();
+  }
+  return f;
+}
+
+void
+ExpectMutuallyNonDominated(const ElitistArchive & archive)
+{
+  const auto & entries = archive.Entries();
+  for (std::size_t i = 0; i < entries.size(); ++i)
+  {
+    ASSERT_TRUE(entries[i].fitness.feasible);
+    for (std::size_t k = 0; k < entries.size(); ++k)
+      if (i != k)
+      {
+        ASSERT_FALSE(morea::Dominates(entries[i].fitness.objectives, entries[k].fitness.objectives)) << i << " " << k;
+        ASSERT_NE(entries[i].fitness.objectives, entries[k].fitness.objectives) << i << " " << k;
+      }
+  }
+}
+
+void
+ExpectOnePerCell(const ElitistArchive & archive)
+{
+  if (!archive.IsDiscretised())
+    return;
+  std::set<std::array<double, 3>> cells;
+  for (const auto & e : archive.Entries())
+    ASSERT_TRUE(cells.insert(CellOf(e.fitness.objectives, archive.CellWidths())).second);
+}
+
+/** Inserts `count` random candidates, checking the archive's promises after
+ *  each. Candidate i gets id i. */
+void
+InsertRandomly(ElitistArchive & archive, std::size_t count, std::uint64_t seed, double shift)
+{
+  morea::RandomGenerator random(seed);
+  std::vector<Fitness>   candidates;
+  for (std::uint64_t id = 0; id < count; ++id)
+  {
+    const Fitness f = RandomCandidate(random, static_cast<double>(id) / static_cast<double>(count), shift);
+    candidates.push_back(f);
+    const std::vector<morea::ArchiveEntry> before = archive.Entries();
+    const bool                            accepted = archive.Accepts(f);
+    const bool                            inserted = archive.Insert(f, PayloadOf(id), id);
+    ASSERT_LE(archive.Size(), archive.Capacity());
+    const auto & entries = archive.Entries();
+    const auto   find = [&](std::uint64_t wanted) {
+      return std::find_if(entries.begin(), entries.end(), [&](const auto & e) { return e.id == wanted; });
+    };
+    ASSERT_EQ(inserted, find(id) != entries.end()) << id;
+    // An entry leaves only when the newcomer dominates it, or when thinned out
+    // for a kept entry in its cell that lies no farther from the cell's corner.
+    std::vector<ObjectiveVector> dropped;
+    for (const auto & b : before)
+      if (find(b.id) == entries.end() && !morea::Dominates(f.objectives, b.fitness.objectives))
+        dropped.push_back(b.fitness.objectives);
+    if (accepted && !inserted) // thinned out at once
+      dropped.push_back(f.objectives);
+    for (const ObjectiveVector & x : dropped)
+    {
+      ASSERT_TRUE(archive.IsDiscretised()) << id;
+      const ObjectiveVector & widths = archive.CellWidths();
+      const auto              keeper = std::find_if(entries.begin(), entries.end(), [&](const auto & e) {
+        return CellOf(e.fitness.objectives, widths) == CellOf(x, widths);
+      });
+      ASSERT_NE(keeper, entries.end()) << id;
+      if (!morea::Dominates(keeper->fitness.objectives, x))
+      {
+        ASSERT_LE(DistanceToCellCorner(keeper->fitness.objectives, widths), DistanceToCellCorner(x, widths)) << id;
+      }
+    }
+    // Every entry is the candidate of its id, with its payload intact (entries
+    // move around when the archive is thinned).
+    for (const auto & e : entries)
+    {
+      ASSERT_LT(e.id, candidates.size());
+      ASSERT_EQ(e.fitness.objectives, candidates[e.id].objectives) << id;
+      ASSERT_EQ(e.solution.source, PayloadOf(e.id).source) << id;
+      ASSERT_EQ(e.solution.target, PayloadOf(e.id).target) << id;
+    }
+    if (!f.feasible)
+      ASSERT_FALSE(inserted) << id;
+    else if (!inserted)
+    {
+      // Rejected (or thinned out at once): dominated by or equal to an entry,
+      // or, when discretised, sharing a cell with one.
+      const bool covered = std::any_of(entries.begin(), entries.end(), [&](const auto & e) {
+        const ObjectiveVector & y = e.fitness.objectives;
+        return y == f.objectives || morea::Dominates(y, f.objectives) ||
+               (archive.IsDiscretised() &&
+                CellOf(y, archive.CellWidths()) == CellOf(f.objectives, archive.CellWidths()));
+      });
+      ASSERT_TRUE(covered) << id;
+      ASSERT_FALSE(archive.Accepts(f)) << id;
+    }
+    if (id % 250 == 0 || id + 1 == count)
+    {
+      ExpectMutuallyNonDominated(archive);
+      ExpectOnePerCell(archive);
+    }
+  }
+}
+} // namespace
+
+TEST(ElitistArchive, RejectsZeroCapacity)
+{
+  EXPECT_THROW(ElitistArchive(0), morea::Error);
+}
+
+TEST(ElitistArchive, InfeasibleNeverEnters)
+{
+  ElitistArchive archive(10);
+  Fitness        f = Feasible(0, 0, 0);
+  f.feasible = false;
+  f.constraint = 0.0;
+  EXPECT_FALSE(archive.Accepts(f));
+  EXPECT_FALSE(archive.Insert(f, PayloadOf(1), 1));
+  EXPECT_EQ(archive.Size(), 0u);
+  EXPECT_TRUE(archive.Insert(Feasible(5, 5, 5), PayloadOf(2), 2));
+  // An infeasible solution that would dominate the entry does not replace it.
+  EXPECT_FALSE(archive.Insert(f, PayloadOf(3), 3));
+  ASSERT_EQ(archive.Size(), 1u);
+  EXPECT_EQ(archive.Entries()[0].id, 2u);
+}
+
+TEST(ElitistArchive, DominatingPointRemovesDominatedOnes)
+{
+  ElitistArchive archive(10);
+  EXPECT_TRUE(archive.Insert(Feasible(2, 2, 2), PayloadOf(0), 0));
+  EXPECT_TRUE(archive.Insert(Feasible(1, 3, 3), PayloadOf(1), 1));
+  EXPECT_TRUE(archive.Insert(Feasible(3, 1, 3), PayloadOf(2), 2));
+  EXPECT_TRUE(archive.Insert(Feasible(3, 3, 1), PayloadOf(3), 3));
+  EXPECT_TRUE(archive.Insert(Feasible(0, 9, 9), PayloadOf(4), 4));
+  EXPECT_EQ(archive.Size(), 5u);
+  // Dominated and equal candidates are refused.
+  EXPECT_FALSE(archive.Accepts(Feasible(2, 2, 3)));
+  EXPECT_FALSE(archive.Insert(Feasible(2, 2, 2), PayloadOf(5), 5));
+  EXPECT_FALSE(archive.Insert(Feasible(1, 9, 9), PayloadOf(6), 6));
+  EXPECT_EQ(archive.Size(), 5u);
+  // (1, 1, 1) dominates all but (0, 9, 9).
+  EXPECT_TRUE(archive.Accepts(Feasible(1, 1, 1)));
+  EXPECT_TRUE(archive.Insert(Feasible(1, 1, 1), PayloadOf(7), 7));
+  ASSERT_EQ(archive.Size(), 2u);
+  EXPECT_EQ(archive.Entries()[0].id, 4u);
+  EXPECT_EQ(archive.Entries()[1].id, 7u);
+  EXPECT_EQ(archive.Objectives(), (std::vector<ObjectiveVector>{ { { 0, 9, 9 } }, { { 1, 1, 1 } } }));
+  EXPECT_FALSE(archive.IsDiscretised());
+}
+
+TEST(ElitistArchive, StoresThePayloadIntact)
+{
+  ElitistArchive        archive(10);
+  const morea::DualMesh solution{ { { { 1.5, -2.0, 3.25 } }, { { 4, 5, 6 } }, { { 7, 8, 9 } } },
+                                  { { { 0.1, 0.2, 0.3 } }, { { -4, -5, -6 } }, { { 1e9, -1e-9, 0 } } } };
+  const Fitness         f = Feasible(1, 2, 3);
+  ASSERT_TRUE(archive.Insert(f, solution, 123456789012345ULL));
+  // More entries around it, so the vector reallocates and entries move.
+  for (std::uint64_t id = 0; id < 8; ++id)
+    archive.Insert(Feasible(2.0 + static_cast<double>(id), 1.0 - 0.1 * static_cast<double>(id), 3.0), PayloadOf(id), id);
+  const auto & entries = archive.Entries();
+  const auto   it = std::find_if(entries.begin(), entries.end(), [](const auto & e) { return e.id == 123456789012345ULL; });
+  ASSERT_NE(it, entries.end());
+  EXPECT_EQ(it->solution.source, solution.source);
+  EXPECT_EQ(it->solution.target, solution.target);
+  EXPECT_EQ(it->fitness.objectives, f.objectives);
+  EXPECT_TRUE(it->fitness.feasible);
+}
+
+TEST(ElitistArchive, RandomInsertionsKeepTheArchiveSound)
+{
+  ElitistArchive archive(200);
+  InsertRandomly(archive, 5000, 42, 0.0);
+  // The run must have exercised the discretised mode, and thinning must not
+  // have gutted the archive.
+  EXPECT_TRUE(archive.IsDiscretised());
+  EXPECT_GT(archive.Size(), archive.Capacity() / 2);
+}
+
+TEST(ElitistArchive, SmallCapacitiesWithNegativeObjectivesFit)
+{
+  // Objective values of both signs: cells must merge them.
+  for (std::size_t capacity : { 1, 2, 3, 7 })
+  {
+    ElitistArchive archive(capacity);
+    InsertRandomly(archive, 600, 100 + capacity, -1.5);
+    EXPECT_TRUE(archive.IsDiscretised()) << capacity;
+    EXPECT_GE(archive.Size(), 1u);
+  }
+}
+
+TEST(ElitistArchive, OverflowSetsWidthsFromTheRange)
+{
+  // Five points on a line in objectives 0 and 1, objective 2 constant:
+  // widths start at range / sqrt(4) = 0.8 / 2 and only grow by factors of 1.1.
+  ElitistArchive archive(4);
+  for (std::uint64_t i = 0; i < 5; ++i)
+  {
+    const double x = 0.1 + 0.2 * static_cast<double>(i);
+    EXPECT_TRUE(archive.Insert(Feasible(x, 1.0 - x, 7.0), PayloadOf(i), i) || i == 4);
+  }
+  ASSERT_TRUE(archive.IsDiscretised());
+  EXPECT_LE(archive.Size(), 4u);
+  const ObjectiveVector widths = archive.CellWidths();
+  EXPECT_EQ(widths[2], 0.0);
+  EXPECT_NEAR(widths[0], widths[1], 1e-12);
+  const double steps = std::log(widths[0] / 0.4) / std::log(1.1);
+  EXPECT_GE(steps, -1e-9);
+  EXPECT_NEAR(steps, std::round(steps), 1e-6);
+  ExpectMutuallyNonDominated(archive);
+  ExpectOnePerCell(archive);
+}
+
+TEST(ElitistArchive, DiscretisedCellAdmitsOnlyADominatingNewcomer)
+{
+  // Widths so wide that all these points share one cell.
+  ElitistArchive archive(10);
+  archive.Restore({ morea::ArchiveEntry{ Feasible(0.2, 0.6, 0.5), PayloadOf(1), 1 } }, true, { { 1000, 1000, 1000 } });
+  // Non-dominated but in the occupied cell without dominating its entry: refused.
+  EXPECT_FALSE(archive.Accepts(Feasible(0.3, 0.5, 0.5)));
+  EXPECT_FALSE(archive.Insert(Feasible(0.3, 0.5, 0.5), PayloadOf(2), 2));
+  // Dominating the entry: it replaces it.
+  EXPECT_TRUE(archive.Insert(Feasible(0.1, 0.5, 0.5), PayloadOf(3), 3));
+  ASSERT_EQ(archive.Size(), 1u);
+  EXPECT_EQ(archive.Entries()[0].id, 3u);
+  // A point in another cell enters freely.
+  EXPECT_TRUE(archive.Insert(Feasible(-2000, 5000, 0.5), PayloadOf(4), 4));
+  EXPECT_EQ(archive.Size(), 2u);
+}
+
+TEST(ElitistArchive, RestoreRoundTrip)
+{
+  ElitistArchive original(150);
+  InsertRandomly(original, 3000, 9, 0.0);
+  ASSERT_TRUE(original.IsDiscretised());
+
+  ElitistArchive restored(150);
+  restored.Restore(original.Entries(), original.IsDiscretised(), original.CellWidths());
+  EXPECT_EQ(restored.IsDiscretised(), original.IsDiscretised());
+  EXPECT_EQ(restored.CellWidths(), original.CellWidths());
+  ASSERT_EQ(restored.Size(), original.Size());
+  for (std::size_t i = 0; i < original.Size(); ++i)
+  {
+    EXPECT_EQ(restored.Entries()[i].id, original.Entries()[i].id);
+    EXPECT_EQ(restored.Entries()[i].fitness.objectives, original.Entries()[i].fitness.objectives);
+    EXPECT_EQ(restored.Entries()[i].solution.source, original.Entries()[i].solution.source);
+    EXPECT_EQ(restored.Entries()[i].solution.target, original.Entries()[i].solution.target);
+  }
+  // Both answer and evolve alike.
+  morea::RandomGenerator random(77);
+  std::size_t            accepted = 0;
+  for (std::uint64_t id = 0; id < 2000; ++id)
+  {
+    const Fitness f = RandomCandidate(random, 1.0 + static_cast<double>(id) / 4000.0, 0.0);
+    ASSERT_EQ(restored.Accepts(f), original.Accepts(f)) << id;
+    accepted += original.Accepts(f);
+    ASSERT_EQ(restored.Insert(f, PayloadOf(id), id), original.Insert(f, PayloadOf(id), id)) << id;
+  }
+  EXPECT_GT(accepted, 0u);
+  EXPECT_EQ(restored.Objectives(), original.Objectives());
+  EXPECT_EQ(restored.CellWidths(), original.CellWidths());
+
+  ElitistArchive tooSmall(original.Size() - 1);
+  EXPECT_THROW(tooSmall.Restore(original.Entries(), true, original.CellWidths()), morea::Error);
+}
+
+TEST(ElitistArchive, RemoveIf)
+{
+  ElitistArchive archive(10);
+  for (std::uint64_t i = 0; i < 5; ++i)
+    archive.Insert(Feasible(static_cast<double>(i), 4.0 - static_cast<double>(i), 0.0), PayloadOf(i), i);
+  archive.RemoveIf([](const morea::ArchiveEntry & e) { return e.fitness.objectives[0] >= 2.5; });
+  ASSERT_EQ(archive.Size(), 3u);
+  for (std::uint64_t i = 0; i < 3; ++i)
+  {
+    EXPECT_EQ(archive.Entries()[i].id, i);
+    EXPECT_EQ(archive.Entries()[i].solution.source, PayloadOf(i).source);
+  }
+  // A removed point may come back.
+  EXPECT_TRUE(archive.Insert(Feasible(3.0, 1.0, 0.0), PayloadOf(3), 3));
+}

@@ -1,0 +1,110 @@
+// Test helper: a small registration problem for the core optimiser, with no
+// ITK: a 30 mm box meshed by 4x4x4 cubes, a fixed image with a bright ball
+// and a moving image with the ball shifted and larger, and the ball as the one
+// guidance structure (analytic distance maps).
+#ifndef morea_test_OptimiserTestProblem_h
+#define morea_test_OptimiserTestProblem_h
+
+#include "BoxMesh.h"
+
+#include "morea/EvaluationBackend.h"
+#include "morea/FoldConstraint.h"
+#include "morea/InitialPopulation.h"
+#include "morea/MoRvGomea.h"
+#include "morea/ObjectiveData.h"
+#include "morea/ParallelStructure.h"
+#include "morea/TetrahedronObjectives.h"
+
+#include <cmath>
+#include <memory>
+
+namespace morea_test
+{
+inline morea::ChannelVolume
+BallImage(const morea::Vec3 & centre, double radius, double spacing, std::size_t size)
+{
+  morea::ChannelVolume v;
+  v.size = { size, size, size };
+  v.spacing = { spacing, spacing, spacing };
+  v.origin = { 0.0, 0.0, 0.0 };
+  v.channels = 2;
+  v.data.resize(2 * size * size * size);
+  for (std::size_t k = 0; k < size; ++k)
+    for (std::size_t j = 0; j < size; ++j)
+      for (std::size_t i = 0; i < size; ++i)
+      {
+        const double x = spacing * static_cast<double>(i) - centre[0];
+        const double y = spacing * static_cast<double>(j) - centre[1];
+        const double z = spacing * static_cast<double>(k) - centre[2];
+        const double r = std::sqrt(x * x + y * y + z * z);
+        const std::size_t o = 2 * (i + size * (j + size * k));
+        // A soft edge keeps the intensity objective smooth; the first slab
+        // is background (exactly 0) so the background rule is exercised.
+        v.data[o] = i == 0 ? 0.0f : static_cast<float>(0.3 + 0.5 / (1.0 + std::exp((r - radius) / 1.0)));
+        v.data[o + 1] = static_cast<float>(std::abs(r - radius));
+      }
+  return v;
+}
+
+struct OptimiserTestProblem
+{
+  morea::TetrahedralMesh               base;
+  morea::MeshTopology                  topology;
+  morea::ParallelStructure             parallel;
+  std::unique_ptr<morea::FoldConstraint> constraint;
+  std::vector<double>                  elasticity;
+  morea::ObjectiveData                 data;
+  std::unique_ptr<morea::TetrahedronEvaluator> evaluator;
+
+  OptimiserTestProblem()
+  {
+    morea::MeshDomain domain;
+    domain.lower = { 0.0, 0.0, 0.0 };
+    domain.upper = { 30.0, 30.0, 30.0 };
+    const BoxMesh box = MakeBoxMesh(domain, { 4, 4, 4 });
+    base.domain = domain;
+    base.points = Perturb(box, 0.15, 3);
+    base.tetrahedra = box.tetrahedra;
+    for (const auto & p : base.points)
+    {
+      base.pins.push_back(morea::PinOf(p, domain, 1e-9));
+      base.origins.push_back(morea::PointOrigin::Random);
+      base.structures.push_back(-1);
+    }
+    topology = morea::MeshTopology(base.tetrahedra, base.points.size());
+    parallel = morea::BuildParallelStructure(topology);
+    constraint = std::make_unique<morea::FoldConstraint>(topology, base.points);
+    elasticity.assign(topology.NumberOfTetrahedra(), 1.0);
+    data.fixed = BallImage({ 15.0, 15.0, 15.0 }, 6.0, 1.0, 31);
+    data.moving = BallImage({ 17.0, 15.0, 14.0 }, 7.5, 1.0, 31);
+    data.guidanceNames = { "ball" };
+    data.guidanceWeights = { 1.0 };
+    data.guidanceRadius = 3.0;
+    data.samplingRate = 0.25;
+    data.voxelVolume = 1.0;
+    evaluator = std::make_unique<morea::TetrahedronEvaluator>(topology, *constraint, elasticity, data);
+  }
+
+  morea::GomeaOptions
+  Options(std::uint64_t seed = 5, std::size_t generations = 8) const
+  {
+    morea::GomeaOptions o;
+    o.populationSize = 24;
+    o.numberOfClusters = 3;
+    o.archiveCapacity = 40;
+    o.generations = generations;
+    o.steeringStart = 5;
+    o.fullEvaluationInterval = 4;
+    o.seed = seed;
+    return o;
+  }
+
+  std::vector<morea::DualMesh>
+  InitialPopulation(const morea::GomeaOptions & o) const
+  {
+    return morea::GenerateInitialPopulation(base, *constraint, o.populationSize, o.seed);
+  }
+};
+} // namespace morea_test
+
+#endif

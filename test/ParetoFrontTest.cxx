@@ -1,0 +1,279 @@
+// Tests of dominance, non-dominated sorting, the hypervolume and the
+// single-solution selections of morea/ParetoFront.h. Core tests: no ITK.
+#include "morea/Error.h"
+#include "morea/ParetoFront.h"
+#include "morea/Random.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <vector>
+
+namespace
+{
+using morea::Fitness;
+using morea::ObjectiveVector;
+
+Fitness
+Feasible(double a, double b, double c)
+{
+  return Fitness{ { { a, b, c } }, true, 0.0 };
+}
+Fitness
+Infeasible(double constraint, double a = 0.0, double b = 0.0, double c = 0.0)
+{
+  return Fitness{ { { a, b, c } }, false, constraint };
+}
+
+/** Exact hypervolume by brute force: the distinct coordinates cut the box
+ *  below the reference into cells, each wholly dominated or not. */
+double
+GridHypervolume(const std::vector<ObjectiveVector> & points, const ObjectiveVector & reference)
+{
+  std::array<std::vector<double>, 3> cuts;
+  for (int j = 0; j < 3; ++j)
+  {
+    cuts[j].push_back(reference[j]);
+    for (const auto & p : points)
+      if (p[j] < reference[j])
+        cuts[j].push_back(p[j]);
+    std::sort(cuts[j].begin(), cuts[j].end());
+    cuts[j].erase(std::unique(cuts[j].begin(), cuts[j].end()), cuts[j].end());
+  }
+  double volume = 0.0;
+  for (std::size_t i = 0; i + 1 < cuts[0].size(); ++i)
+    for (std::size_t k = 0; k + 1 < cuts[1].size(); ++k)
+      for (std::size_t l = 0; l + 1 < cuts[2].size(); ++l)
+      {
+        const ObjectiveVector centre{ { (cuts[0][i] + cuts[0][i + 1]) / 2, (cuts[1][k] + cuts[1][k + 1]) / 2,
+                                        (cuts[2][l] + cuts[2][l + 1]) / 2 } };
+        const bool dominated = std::any_of(points.begin(), points.end(), [&](const ObjectiveVector & p) {
+          return p[0] <= centre[0] && p[1] <= centre[1] && p[2] <= centre[2];
+        });
+        if (dominated)
+          volume += (cuts[0][i + 1] - cuts[0][i]) * (cuts[1][k + 1] - cuts[1][k]) * (cuts[2][l + 1] - cuts[2][l]);
+      }
+  return volume;
+}
+} // namespace
+
+TEST(ParetoFront, Dominance)
+{
+  using morea::Dominates;
+  EXPECT_TRUE(Dominates({ { 1, 2, 3 } }, { { 1, 2, 4 } }));
+  EXPECT_TRUE(Dominates({ { 0, 0, 0 } }, { { 1, 1, 1 } }));
+  EXPECT_FALSE(Dominates({ { 1, 2, 3 } }, { { 1, 2, 3 } })); // equal: no strict improvement
+  EXPECT_FALSE(Dominates({ { 1, 2, 3 } }, { { 2, 1, 3 } })); // trade-off
+  EXPECT_FALSE(Dominates({ { 2, 1, 3 } }, { { 1, 2, 3 } }));
+  EXPECT_FALSE(Dominates({ { 1, 2, 4 } }, { { 1, 2, 3 } }));
+}
+
+TEST(ParetoFront, ConstraintDomination)
+{
+  using morea::ConstraintDominates;
+  // Feasible beats infeasible whatever the objectives.
+  EXPECT_TRUE(ConstraintDominates(Feasible(9, 9, 9), Infeasible(0.1, 0, 0, 0)));
+  EXPECT_FALSE(ConstraintDominates(Infeasible(0.1, 0, 0, 0), Feasible(9, 9, 9)));
+  // Two infeasible: the smaller violation wins, objectives do not matter.
+  EXPECT_TRUE(ConstraintDominates(Infeasible(1.0, 9, 9, 9), Infeasible(2.0, 0, 0, 0)));
+  EXPECT_FALSE(ConstraintDominates(Infeasible(2.0, 0, 0, 0), Infeasible(1.0, 9, 9, 9)));
+  EXPECT_FALSE(ConstraintDominates(Infeasible(1.0, 0, 0, 0), Infeasible(1.0, 9, 9, 9)));
+  // Two feasible: Pareto dominance.
+  EXPECT_TRUE(ConstraintDominates(Feasible(1, 1, 1), Feasible(1, 2, 1)));
+  EXPECT_FALSE(ConstraintDominates(Feasible(1, 2, 1), Feasible(2, 1, 1)));
+  EXPECT_FALSE(ConstraintDominates(Feasible(1, 1, 1), Feasible(1, 1, 1)));
+}
+
+TEST(ParetoFront, RanksUnderConstraintDomination)
+{
+  const std::vector<Fitness> population{
+    Feasible(1, 1, 1),         // 0: first front
+    Feasible(2, 2, 2),         // 1: dominated by 0
+    Feasible(0, 5, 0),         // 2: trade-off with 0 -> first front
+    Feasible(3, 3, 3),         // 3: dominated by 1
+    Infeasible(1.0, 0, 0, 0),  // 4: behind every feasible one
+    Infeasible(2.0, 0, 0, 0),  // 5: behind 4 (larger violation)
+    Infeasible(1.0, 9, 9, 9),  // 6: same violation as 4 -> same rank
+    Feasible(1, 1, 1),         // 7: duplicate of 0 -> same rank
+    Feasible(2.5, 2.5, 0.5),   // 8: dominated by none of 0, 2 -> first front
+  };
+  EXPECT_EQ(morea::NonDominatedRanks(population), (std::vector<std::size_t>{ 0, 1, 0, 2, 3, 4, 3, 0, 0 }));
+  EXPECT_TRUE(morea::NonDominatedRanks({}).empty());
+  EXPECT_EQ(morea::NonDominatedRanks({ Infeasible(3.0) }), (std::vector<std::size_t>{ 0 }));
+}
+
+TEST(ParetoFront, RanksAgreeWithDefinitionOnRandomPopulation)
+{
+  // Rank r: dominated only by solutions of rank < r, and by one of rank r - 1.
+  morea::RandomGenerator random(7);
+  std::vector<Fitness>   population;
+  for (int i = 0; i < 300; ++i)
+  {
+    Fitness f = Feasible(random.Uniform(), random.Uniform(), random.Uniform());
+    if (random.Uniform() < 0.2)
+    {
+      f.feasible = false;
+      f.constraint = std::floor(random.Uniform(0.0, 5.0));
+    }
+    population.push_back(f);
+  }
+  const auto ranks = morea::NonDominatedRanks(population);
+  for (std::size_t i = 0; i < population.size(); ++i)
+  {
+    bool dominatedByPreviousRank = false;
+    for (std::size_t k = 0; k < population.size(); ++k)
+      if (morea::ConstraintDominates(population[k], population[i]))
+      {
+        ASSERT_LT(ranks[k], ranks[i]);
+        dominatedByPreviousRank = dominatedByPreviousRank || ranks[k] + 1 == ranks[i];
+      }
+    EXPECT_TRUE(ranks[i] == 0 || dominatedByPreviousRank) << i;
+  }
+}
+
+TEST(ParetoFront, HypervolumeOfHandComputedSets)
+{
+  const ObjectiveVector reference{ { 4, 4, 4 } };
+  EXPECT_EQ(morea::Hypervolume({}, reference), 0.0);
+  // One box: 3 * 2 * 1.
+  EXPECT_DOUBLE_EQ(morea::Hypervolume({ { { 1, 2, 3 } } }, reference), 6.0);
+  // Two overlapping boxes: 6 + 6 - overlap [2,4]x[2,4]x[3,4] = 4 -> 8.
+  EXPECT_DOUBLE_EQ(morea::Hypervolume({ { { 1, 2, 3 } }, { { 2, 1, 3 } } }, reference), 8.0);
+  // A third box [3,4]x[3,4]x[1,4] = 3, of which [3,4]^3 = 1 is covered -> 10.
+  const std::vector<ObjectiveVector> three{ { { 1, 2, 3 } }, { { 2, 1, 3 } }, { { 3, 3, 1 } } };
+  EXPECT_DOUBLE_EQ(morea::Hypervolume(three, reference), 10.0);
+  // Order does not matter; dominated points and duplicates add nothing.
+  std::vector<ObjectiveVector> more{ three[2], { { 3, 3, 3 } }, three[0], three[1], three[0] };
+  EXPECT_DOUBLE_EQ(morea::Hypervolume(more, reference), 10.0);
+  // Points not strictly better than the reference in every objective are ignored,
+  // even where they would otherwise dominate the others.
+  more.push_back({ { 5, 0, 0 } });
+  more.push_back({ { 0, 4, 0 } });
+  more.push_back({ { 0, 0, 4 } });
+  EXPECT_DOUBLE_EQ(morea::Hypervolume(more, reference), 10.0);
+  // Negative coordinates and a shifted reference.
+  EXPECT_DOUBLE_EQ(morea::Hypervolume({ { { -1, -2, -3 } } }, { { 0, 0, 0 } }), 6.0);
+}
+
+TEST(ParetoFront, HypervolumeMatchesBruteForceOnRandomSets)
+{
+  morea::RandomGenerator random(11);
+  const ObjectiveVector  reference{ { 1.0, 1.2, 0.9 } };
+  for (int trial = 0; trial < 40; ++trial)
+  {
+    const int                    n = 1 + trial;
+    std::vector<ObjectiveVector> points;
+    for (int i = 0; i < n; ++i)
+    {
+      // Half near the front x + y + z = 1 (many mutually non-dominated), half
+      // anywhere (some dominated, some beyond the reference); some repeated
+      // coordinates to exercise ties.
+      ObjectiveVector p{ { random.Uniform(), random.Uniform(), random.Uniform() } };
+      if (i % 2 == 0)
+      {
+        const double s = p[0] + p[1] + p[2];
+        for (double & x : p)
+          x = x / s + random.Uniform(-0.02, 0.02);
+      }
+      else
+        for (double & x : p)
+          x *= 1.3;
+      if (i % 5 == 4)
+        p[random.NextU64() % 3] = points.front()[random.NextU64() % 3];
+      points.push_back(p);
+    }
+    const double exact = GridHypervolume(points, reference);
+    EXPECT_NEAR(morea::Hypervolume(points, reference), exact, 1e-12 * std::max(1.0, exact)) << "trial " << trial;
+  }
+}
+
+TEST(ParetoFront, HypervolumeOf2000PointsIsFast)
+{
+  // 2000 points on the unit sphere's positive octant, all non-dominated. Their
+  // boxes lie outside the ball, so the volume is below 1 - pi/6 and near it.
+  morea::RandomGenerator       random(3);
+  std::vector<ObjectiveVector> points;
+  while (points.size() < 2000)
+  {
+    ObjectiveVector p{ { std::abs(random.Normal()), std::abs(random.Normal()), std::abs(random.Normal()) } };
+    const double    norm = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+    if (norm == 0.0)
+      continue;
+    for (double & x : p)
+      x /= norm;
+    points.push_back(p);
+  }
+  const auto   start = std::chrono::steady_clock::now();
+  const double volume = morea::Hypervolume(points, { { 1, 1, 1 } });
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  std::printf("Hypervolume of %zu points: %.3f ms\n", points.size(), ms);
+  EXPECT_LT(ms, 50.0);
+  const double bound = 1.0 - std::acos(-1.0) / 6.0;
+  EXPECT_LT(volume, bound);
+  EXPECT_GT(volume, 0.9 * bound);
+}
+
+TEST(ParetoFront, SelectBestGuidance)
+{
+  // Guidance 2 twice: index 1 has the smaller normalised sum (1/3 + 1/5 + 0
+  // against 0 + 1 + 0).
+  const std::vector<ObjectiveVector> front{ { { 0, 0, 5 } }, { { 1, 1, 2 } }, { { 0, 5, 2 } }, { { 3, 3, 9 } } };
+  EXPECT_EQ(morea::SelectBestGuidance(front), 1u);
+  EXPECT_EQ(morea::SelectBestGuidance({ { { 7, 7, 7 } } }), 0u);
+  EXPECT_THROW(morea::SelectBestGuidance({}), morea::Error);
+}
+
+TEST(ParetoFront, SelectKnee)
+{
+  // Extremes on the plane x + y + z = 1; (0.2, 0.2, 0.2) lies farthest below it.
+  std::vector<ObjectiveVector> front{ { { 1, 0, 0 } },       { { 0.3, 0.3, 0.1 } }, { { 0, 1, 0 } },
+                                      { { 0.2, 0.2, 0.2 } }, { { 0, 0, 1 } },       { { 0.1, 0.1, 0.9 } } };
+  EXPECT_EQ(morea::SelectKnee(front), 3u);
+  // Normalisation: rescaling and shifting objectives changes nothing.
+  for (auto & p : front)
+    p = { { 100.0 * p[0] + 5.0, p[1] - 2.0, 0.01 * p[2] } };
+  EXPECT_EQ(morea::SelectKnee(front), 3u);
+
+  // A front flat in one objective has two extremes: the one nearest the ideal
+  // point is (0.25, 0.25) normalised.
+  EXPECT_EQ(morea::SelectKnee({ { { 0, 4, 1 } }, { { 4, 0, 1 } }, { { 1, 1, 1 } }, { { 3, 0.5, 1 } } }), 2u);
+  EXPECT_EQ(morea::SelectKnee({ { { 1, 2, 3 } } }), 0u);
+  EXPECT_THROW(morea::SelectKnee({}), morea::Error);
+}
+
+TEST(ParetoFront, SelectWeighted)
+{
+  const std::vector<ObjectiveVector> front{ { { 0, 10, 10 } }, { { 10, 0, 10 } }, { { 10, 10, 0 } }, { { 4, 4, 4 } } };
+  EXPECT_EQ(morea::SelectWeighted(front, { { 1, 0, 0 } }), 0u);
+  EXPECT_EQ(morea::SelectWeighted(front, { { 0, 0, 2 } }), 2u);
+  EXPECT_EQ(morea::SelectWeighted(front, { { 1, 1, 1 } }), 3u); // 1.2 against 2
+  EXPECT_EQ(morea::SelectWeighted(front, { { 0, 3, 1 } }), 1u); // 1 against 1.6
+  // Weights act on normalised objectives: objective 0 in large units does not
+  // swamp the others.
+  const std::vector<ObjectiveVector> scaled{ { { 0, 1, 1 } }, { { 1000, 0, 0.6 } } };
+  EXPECT_EQ(morea::SelectWeighted(scaled, { { 1, 1, 1 } }), 1u); // 1 against 2
+
+  EXPECT_THROW(morea::SelectWeighted(front, { { 0, 0, 0 } }), morea::Error);
+  EXPECT_THROW(morea::SelectWeighted(front, { { 1, -1, 1 } }), morea::Error);
+  EXPECT_THROW(morea::SelectWeighted(front, { { 1, std::numeric_limits<double>::quiet_NaN(), 1 } }), morea::Error);
+  EXPECT_THROW(morea::SelectWeighted(front, { { 1, std::numeric_limits<double>::infinity(), 1 } }), morea::Error);
+  EXPECT_THROW(morea::SelectWeighted({}, { { 1, 1, 1 } }), morea::Error);
+}
+
+TEST(ParetoFront, SelectNearest)
+{
+  const std::vector<ObjectiveVector> front{ { { 0, 10, 10 } }, { { 10, 0, 10 } }, { { 10, 10, 0 } }, { { 4, 4, 4 } } };
+  EXPECT_EQ(morea::SelectNearest(front, { { 10, 0, 10 } }), 1u);
+  EXPECT_EQ(morea::SelectNearest(front, { { 5, 5, 5 } }), 3u);
+  EXPECT_EQ(morea::SelectNearest(front, { { 9, 8, -3 } }), 2u);
+  // Distances are taken after normalising: (60, 1, 0) is (0.6, 1, 0), nearer
+  // (0, 1, 0) than (1, 0, 0), though in raw units it is nearer (100, 0, 0).
+  const std::vector<ObjectiveVector> scaled{ { { 0, 1, 0 } }, { { 100, 0, 0 } } };
+  EXPECT_EQ(morea::SelectNearest(scaled, { { 60, 1, 0 } }), 0u);
+  EXPECT_EQ(morea::SelectNearest(scaled, { { 80, 0.2, 0 } }), 1u);
+  EXPECT_THROW(morea::SelectNearest({}, { { 0, 0, 0 } }), morea::Error);
+}

@@ -1,0 +1,205 @@
+// The objectives per tetrahedron: exact partial evaluation, the background
+// rule, guidance truncation, and CPU backend batches.
+#include "OptimiserTestProblem.h"
+
+#include "morea/MagnitudeObjective.h"
+#include "morea/Random.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+using namespace morea;
+using morea_test::OptimiserTestProblem;
+
+namespace
+{
+ObjectiveTotals
+FullTotals(const TetrahedronEvaluator & evaluator, const DualMesh & solution)
+{
+  ObjectiveTotals totals;
+  for (std::size_t t = 0; t < evaluator.Topology().NumberOfTetrahedra(); ++t)
+    totals.Add(evaluator.Evaluate(t, solution));
+  return totals;
+}
+
+void
+ExpectRelativelyEqual(double a, double b, double relative)
+{
+  EXPECT_NEAR(a, b, relative * std::max(std::abs(a), std::abs(b)) + 1e-300);
+}
+} // namespace
+
+TEST(TetrahedronObjectives, IdenticalImagesAndMeshesCostNothing)
+{
+  OptimiserTestProblem problem;
+  problem.data.moving = problem.data.fixed;
+  const TetrahedronEvaluator evaluator(problem.topology, *problem.constraint, problem.elasticity, problem.data);
+  const DualMesh             identity = DualMesh::FromBase(problem.base);
+  const Fitness              f = FullTotals(evaluator, identity).ToFitness(problem.topology.NumberOfTetrahedra());
+  EXPECT_TRUE(f.feasible);
+  EXPECT_EQ(f.objectives[0], 0.0);
+  EXPECT_EQ(f.objectives[1], 0.0);
+  EXPECT_EQ(f.objectives[2], 0.0);
+}
+
+TEST(TetrahedronObjectives, MagnitudeMatchesTheWholeObjectiveAndSamplesFollowVolume)
+{
+  OptimiserTestProblem problem;
+  const auto           population = problem.InitialPopulation(problem.Options());
+  const DualMesh &     s = population[3];
+  const ObjectiveTotals totals = FullTotals(*problem.evaluator, s);
+  const Fitness         f = totals.ToFitness(problem.topology.NumberOfTetrahedra());
+  ExpectRelativelyEqual(f.objectives[0], MagnitudeObjective(problem.topology, s, problem.elasticity), 1e-12);
+  // Both meshes tile the 30 mm box, so each direction draws about
+  // rate * 27000 samples (rounding per tetrahedron adds at most 1/2 each).
+  const double expected = 2.0 * problem.data.samplingRate * 30.0 * 30.0 * 30.0;
+  EXPECT_NEAR(totals.sum.samples, expected, 0.5 * 2.0 * static_cast<double>(problem.topology.NumberOfTetrahedra()));
+  EXPECT_GT(f.objectives[1], 0.0);
+  EXPECT_GT(f.objectives[2], 0.0);
+}
+
+TEST(TetrahedronObjectives, SumOfPartialEvaluationsEqualsFullEvaluation)
+{
+  OptimiserTestProblem problem;
+  const auto           population = problem.InitialPopulation(problem.Options());
+  DualMesh             solution = population[1];
+  ObjectiveTotals      running = FullTotals(*problem.evaluator, solution);
+  std::vector<TetrahedronValues> cached(problem.topology.NumberOfTetrahedra());
+  for (std::size_t t = 0; t < cached.size(); ++t)
+    cached[t] = problem.evaluator->Evaluate(t, solution);
+  // Move every FOS element in turn to another solution's positions, updating
+  // the totals by partial evaluations only; then compare with a full one.
+  auto backend = CreateCpuEvaluationBackend(*problem.evaluator, 2);
+  RandomGenerator random(11);
+  for (int round = 0; round < 3; ++round)
+    for (const auto & element : problem.parallel.elements)
+    {
+      const DualMesh &  donor = population[2 + static_cast<std::size_t>(random.Uniform() * 20.0)];
+      std::vector<Vec3> source, target;
+      for (std::uint32_t p : element.points)
+      {
+        source.push_back(donor.source[p]);
+        target.push_back(donor.target[p]);
+      }
+      std::vector<TetrahedronValues> values(element.dependentTetrahedra.size());
+      PartialCandidate               c{ &solution, &element, source.data(), target.data(), values.data() };
+      backend->EvaluatePartials({ c });
+      for (std::size_t k = 0; k < values.size(); ++k)
+      {
+        running.Add(cached[element.dependentTetrahedra[k]], -1.0);
+        running.Add(values[k]);
+        cached[element.dependentTetrahedra[k]] = values[k];
+      }
+      for (std::size_t k = 0; k < element.points.size(); ++k)
+      {
+        solution.source[element.points[k]] = source[k];
+        solution.target[element.points[k]] = target[k];
+      }
+    }
+  const ObjectiveTotals full = FullTotals(*problem.evaluator, solution);
+  const std::size_t     n = problem.topology.NumberOfTetrahedra();
+  const Fitness         a = running.ToFitness(n), b = full.ToFitness(n);
+  for (std::size_t m = 0; m < NumberOfObjectives; ++m)
+    ExpectRelativelyEqual(a.objectives[m], b.objectives[m], 1e-6);
+  EXPECT_EQ(running.sum.samples, full.sum.samples);
+  EXPECT_EQ(a.feasible, b.feasible);
+  ExpectRelativelyEqual(running.sum.foldValue, full.sum.foldValue, 1e-6);
+}
+
+TEST(TetrahedronObjectives, BackgroundAgainstTissueCostsOne)
+{
+  OptimiserTestProblem problem;
+  // Moving image all background, fixed all tissue: every sample costs 1.
+  for (std::size_t i = 0; i < problem.data.moving.data.size(); i += 2)
+  {
+    problem.data.moving.data[i] = 0.0f;
+    problem.data.fixed.data[i] = 0.5f;
+  }
+  const TetrahedronEvaluator evaluator(problem.topology, *problem.constraint, problem.elasticity, problem.data);
+  const Fitness f = FullTotals(evaluator, DualMesh::FromBase(problem.base)).ToFitness(problem.topology.NumberOfTetrahedra());
+  EXPECT_DOUBLE_EQ(f.objectives[1], 1.0);
+  // Both background: nothing.
+  for (std::size_t i = 0; i < problem.data.fixed.data.size(); i += 2)
+    problem.data.fixed.data[i] = 0.0f;
+  const TetrahedronEvaluator both(problem.topology, *problem.constraint, problem.elasticity, problem.data);
+  EXPECT_EQ(FullTotals(both, DualMesh::FromBase(problem.base)).ToFitness(problem.topology.NumberOfTetrahedra()).objectives[1],
+            0.0);
+}
+
+TEST(TetrahedronObjectives, GuidanceCountsOnlySamplesNearAContour)
+{
+  OptimiserTestProblem problem;
+  // Distances everywhere beyond the radius on both sides: no guidance at all,
+  // however far the structures disagree.
+  for (auto * v : { &problem.data.fixed, &problem.data.moving })
+    for (std::size_t i = 1; i < v->data.size(); i += 2)
+      v->data[i] = v == &problem.data.fixed ? 50.0f : 3.0f;
+  const TetrahedronEvaluator far(problem.topology, *problem.constraint, problem.elasticity, problem.data);
+  const DualMesh             base = DualMesh::FromBase(problem.base);
+  EXPECT_EQ(FullTotals(far, base).sum.guidance, 0.0);
+  // Moving distances 1 mm (within r = 3), fixed 50 mm: only the
+  // moving-to-fixed direction counts, each sample (r-d)/r (d-d')^2.
+  for (std::size_t i = 1; i < problem.data.moving.data.size(); i += 2)
+    problem.data.moving.data[i] = 1.0f;
+  const TetrahedronEvaluator near(problem.topology, *problem.constraint, problem.elasticity, problem.data);
+  const ObjectiveTotals       totals = FullTotals(near, base);
+  const double                perSample = (3.0 - 1.0) / 3.0 * 49.0 * 49.0;
+  EXPECT_NEAR(totals.sum.guidance, perSample * totals.sum.samples / 2.0, 1e-6 * totals.sum.guidance);
+}
+
+TEST(TetrahedronObjectives, FoldedTetrahedraAreCountedInBothMeshes)
+{
+  OptimiserTestProblem problem;
+  DualMesh             s = DualMesh::FromBase(problem.base);
+  // Push an inner point through the opposite face of one of its tetrahedra.
+  const std::uint32_t inner = static_cast<std::uint32_t>(1 + 5 * (1 + 5 * 1)); // grid point (1,1,1)
+  s.target[inner] = { 25.0, 25.0, 25.0 };
+  const Fitness f = FullTotals(*problem.evaluator, s).ToFitness(problem.topology.NumberOfTetrahedra());
+  EXPECT_FALSE(f.feasible);
+  EXPECT_NEAR(f.constraint, problem.constraint->Evaluate(s).value, 1e-9);
+  EXPECT_GT(f.constraint, 0.0);
+}
+
+TEST(CpuEvaluationBackend, BatchResultDoesNotDependOnOrderOrThreads)
+{
+  OptimiserTestProblem problem;
+  const auto           population = problem.InitialPopulation(problem.Options());
+  // All elements of the first parallel group for 5 solutions.
+  std::vector<std::vector<Vec3>>              sources, targets;
+  std::vector<std::vector<TetrahedronValues>> one, two;
+  std::vector<PartialCandidate>               a, b;
+  for (std::size_t s = 0; s < 5; ++s)
+    for (std::uint32_t e : problem.parallel.groups[0])
+    {
+      const auto &      element = problem.parallel.elements[e];
+      std::vector<Vec3> src, tgt;
+      for (std::uint32_t p : element.points)
+      {
+        src.push_back(population[10 + s].source[p]);
+        tgt.push_back(population[10 + s].target[p]);
+      }
+      sources.push_back(src);
+      targets.push_back(tgt);
+      one.emplace_back(element.dependentTetrahedra.size());
+      two.emplace_back(element.dependentTetrahedra.size());
+    }
+  std::size_t i = 0;
+  for (std::size_t s = 0; s < 5; ++s)
+    for (std::uint32_t e : problem.parallel.groups[0])
+    {
+      a.push_back({ &population[s], &problem.parallel.elements[e], sources[i].data(), targets[i].data(), one[i].data() });
+      b.push_back({ &population[s], &problem.parallel.elements[e], sources[i].data(), targets[i].data(), two[i].data() });
+      ++i;
+    }
+  std::reverse(b.begin(), b.end());
+  CreateCpuEvaluationBackend(*problem.evaluator, 1)->EvaluatePartials(a);
+  CreateCpuEvaluationBackend(*problem.evaluator, 3)->EvaluatePartials(b);
+  for (std::size_t j = 0; j < one.size(); ++j)
+    for (std::size_t k = 0; k < one[j].size(); ++k)
+    {
+      EXPECT_EQ(one[j][k].intensity, two[j][k].intensity);
+      EXPECT_EQ(one[j][k].guidance, two[j][k].guidance);
+      EXPECT_EQ(one[j][k].magnitude, two[j][k].magnitude);
+    }
+}
