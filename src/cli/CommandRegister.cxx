@@ -5,9 +5,11 @@
 
 #include "itkMOREAImageIO.h"
 #include "itkMeshRegistration.h"
+#include "itkMultiObjectiveMeshRegistrationFilterSupport.h"
 #include "itkPreprocessing.h"
 #include "itkRigidPreAlignment.h"
 
+#include <csignal>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -26,6 +28,7 @@ AddRegisterCommand(CLI::App & app)
     std::size_t      checkpointEvery{ 10 };
     bool             resume{ false };
     std::size_t      threads{ 0 };
+    std::size_t      killAfter{ 0 };
   };
   auto   options = std::make_shared<Options>();
   auto * cmd = app.add_subcommand("register", "register a problem with MOREA and write the approximation set");
@@ -40,9 +43,13 @@ AddRegisterCommand(CLI::App & app)
     ->capture_default_str();
   cmd->add_flag("--resume", options->resume, "continue from output/checkpoint.bin when it exists");
   cmd->add_option("--threads", options->threads, "CPU threads (0: all)")->capture_default_str();
+  // For crash-recovery tests: the process kills itself (SIGKILL) right after
+  // generation N, as an external kill would, leaving only the checkpoint.
+  cmd->add_option("--kill-after-generation", options->killAfter)->group("");
   cmd->callback([options] {
     namespace fs = std::filesystem;
     const auto parameters = options->parameters.Load();
+    itk::morea::CheckSolutionSelection(options->select); // before a long run, not after
     const auto input = options->problem.Load();
     const auto preprocessed = itk::morea::Preprocess(input, itk::morea::PreprocessOptions::FromParameters(parameters));
     const auto & r = preprocessed.report;
@@ -59,7 +66,12 @@ AddRegisterCommand(CLI::App & app)
     run.checkpointInterval = options->checkpointEvery;
     run.resume = options->resume;
     run.threads = options->threads;
-    run.onGeneration = ProgressPrinter();
+    run.onGeneration = [print = ProgressPrinter(), killAfter = options->killAfter](
+                         const ::morea::GenerationRecord & r, std::size_t total) {
+      print(r, total);
+      if (killAfter > 0 && r.generation == killAfter)
+        std::raise(SIGKILL);
+    };
     const auto result = itk::morea::RegisterMeshes(preprocessed.problem, parameters, run);
     if (result.resumedAtGeneration > 0)
       std::cout << "resumed from generation " << result.resumedAtGeneration << "\n";

@@ -3,6 +3,7 @@
 #include "itkImageRegionConstIteratorWithIndex.h"
 #include "itkMOREAImageIO.h"
 #include "itkMeshTransforms.h"
+#include "itkMultiObjectiveMeshRegistrationFilterSupport.h"
 #include "itkRegistrationEvaluation.h"
 #include "morea/Error.h"
 #include "morea/ParetoFront.h"
@@ -18,42 +19,6 @@ namespace morea::cli
 {
 namespace
 {
-std::vector<::morea::ObjectiveVector>
-Objectives(const std::vector<itk::morea::FrontSolution> & front)
-{
-  std::vector<::morea::ObjectiveVector> v;
-  for (const auto & s : front)
-    v.push_back(s.fitness.objectives);
-  return v;
-}
-
-::morea::ObjectiveVector
-ParseTriple(const std::string & item, const std::string & text)
-{
-  std::vector<std::string> parts;
-  std::istringstream       in(text);
-  for (std::string part; std::getline(in, part, ':');)
-    parts.push_back(part);
-  ::morea::ObjectiveVector v{};
-  try
-  {
-    if (parts.size() != 3)
-      throw std::invalid_argument(text);
-    for (std::size_t m = 0; m < 3; ++m)
-    {
-      std::size_t used = 0;
-      v[m] = std::stod(parts[m], &used);
-      if (used != parts[m].size())
-        throw std::invalid_argument(parts[m]);
-    }
-  }
-  catch (const std::exception &)
-  {
-    throw ::morea::Error("--select: '" + item + "' needs three numbers (magnitude:intensity:guidance)");
-  }
-  return v;
-}
-
 /** Mean |u - truth| in mm over the voxels inside the body (intensity > 0). */
 double
 MeanDisplacementError(const itk::morea::DisplacementFieldType * field, const itk::morea::DisplacementFieldType * truth,
@@ -79,33 +44,9 @@ ChooseSolutions(const std::vector<itk::morea::FrontSolution> & front, const std:
 {
   if (front.empty())
     throw ::morea::Error("the approximation set is empty: no fold-free solution was found");
-  const auto                  objectives = Objectives(front);
   std::vector<ChosenSolution> chosen;
-  auto                        add = [&](const std::string & label, std::size_t index) {
-    for (const auto & c : chosen)
-      if (c.label == label)
-        return;
-    chosen.push_back({ label, index });
-  };
-  for (const std::string & item : ::morea::ParseNameList(selection))
-  {
-    if (item == "best-guidance")
-      add("best_guidance", ::morea::SelectBestGuidance(objectives));
-    else if (item == "knee")
-      add("knee", ::morea::SelectKnee(objectives));
-    else if (item == "all")
-      for (std::size_t i = 0; i < front.size(); ++i)
-        add("solution_" + std::to_string(front[i].id), i);
-    else if (item.rfind("weighted:", 0) == 0)
-      add("weighted", ::morea::SelectWeighted(objectives, ParseTriple(item, item.substr(9))));
-    else if (item.rfind("nearest:", 0) == 0)
-      add("nearest", ::morea::SelectNearest(objectives, ParseTriple(item, item.substr(8))));
-    else
-      throw ::morea::Error("--select: unknown choice '" + item +
-                           "' (best-guidance, knee, weighted:a:b:c, nearest:m:i:g, all)");
-  }
-  if (chosen.empty())
-    throw ::morea::Error("--select: no solution chosen");
+  for (const auto & c : itk::morea::SelectSolutions(itk::morea::ToApproximationSet(front), selection))
+    chosen.push_back({ c.label, c.index });
   return chosen;
 }
 

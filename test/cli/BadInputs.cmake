@@ -383,6 +383,16 @@ expect_failure("mesh: negative elasticity factor" OUTPUTS ${o} FRAGMENTS "morea_
   ARGS mesh --fixed "${fixed}" --moving "${moving}" ${blob} --set "morea_elasticity_factors=blob=-2" -o "${o}")
 expect_failure("mesh: unknown guidance structure" OUTPUTS ${o} FRAGMENTS "liver"
   ARGS mesh --fixed "${fixed}" --moving "${moving}" ${blob} --set problem_guidance_selection=liver -o "${o}")
+
+# --- register ------------------------------------------------------------------------------------------
+set(o "${WORK}/register-out")
+expect_failure("register: unknown solution choice" OUTPUTS ${o} FRAGMENTS "bogus" "best-guidance"
+  ARGS register --fixed "${fixed}" --moving "${moving}" ${blob} --select bogus -o "${o}")
+file(WRITE "${WORK}/register-bad-checkpoint/checkpoint.bin" "MOREACKP but not a checkpoint")
+expect_failure("register: resume from a damaged checkpoint" OUTPUTS ${o}/front.csv FRAGMENTS "checkpoint"
+  ARGS register --fixed "${fixed}" --moving "${moving}" ${blob} --set ea_population_size=8 --set ea_num_clusters=2
+       --set ea_num_generations=2 --set morea_mesh_num_points=40 --set preprocess_rigid_structure=none --resume -o "${WORK}/register-bad-checkpoint")
+file(REMOVE_RECURSE "${WORK}/register-bad-checkpoint")
 expect_failure("mesh: too few points" USAGE OUTPUTS ${o} FRAGMENTS "morea_mesh_num_points"
   ARGS mesh --fixed "${fixed}" --moving "${moving}" ${blob} --set morea_mesh_num_points=4 -o "${o}")
 

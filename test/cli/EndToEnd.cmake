@@ -244,4 +244,54 @@ if(NOT shrunk)
                       "default 30 mm margin (${pre_size}); was the placeholder substituted?")
 endif()
 
+# --- register: a tiny MOREA run on the phantom, then a killed run resumed ------------------------------
+set(tiny --set ea_population_size=12 --set ea_num_clusters=2 --set ea_archive_size=30 --set morea_mesh_num_points=80
+         --set morea_sampling_rate=0.2 --set preprocess_isotropic_spacing=4 --set seed=2
+         --set ea_adaptive_steering_activated_at_num_generations=3)
+set(reg "${WORK}/register")
+morea_ok("register" register --problem "${phantom}" ${tiny} --set ea_num_generations=6 --checkpoint-every 2
+  -o "${reg}")
+expect_files("register"
+  "${reg}/front.csv" "${reg}/front.json" "${reg}/generations.csv" "${reg}/summary.json" "${reg}/checkpoint.bin"
+  "${reg}/parameters.toml" "${reg}/rigid_fixed_to_moving.tfm"
+  "${reg}/best_guidance/preprocessed_fixed_to_moving.nii.gz" "${reg}/best_guidance/preprocessed_moving_to_fixed.nii.gz"
+  "${reg}/best_guidance/fixed_to_moving.h5" "${reg}/best_guidance/moving_to_fixed.h5"
+  "${reg}/best_guidance/mesh_moving.vtu" "${reg}/best_guidance/mesh_fixed.vtu" "${reg}/best_guidance/scores.json"
+  "${reg}/knee/fixed_to_moving.h5")
+file(STRINGS "${reg}/generations.csv" gen_lines)
+list(LENGTH gen_lines gen_count)
+if(NOT gen_count EQUAL 8) # header, generation 0 (initial population), 1..6
+  message(FATAL_ERROR "register: generations.csv has ${gen_count} lines, expected 8")
+endif()
+file(READ "${reg}/summary.json" reg_json)
+json_number(reg_dice "summary.json" "${reg_json}" solutions best_guidance scores structures bladder dice)
+json_number(reg_fold "summary.json" "${reg_json}" solutions best_guidance scores jacobian_nonpositive_fraction)
+if(reg_fold GREATER 0)
+  message(FATAL_ERROR "register: the best-guidance solution folds (Jacobian <= 0 in ${reg_fold} of the voxels)")
+endif()
+
+# Killed and resumed: the same seed ends with the same front as one uninterrupted run.
+set(full "${WORK}/register-full")
+morea_ok("register (uninterrupted)" register --problem "${phantom}" ${tiny} --set ea_num_generations=30
+  --checkpoint-every 0 --select best-guidance -o "${full}")
+set(killed "${WORK}/register-killed")
+execute_process(COMMAND "${MOREA}" register --problem "${phantom}" ${tiny} --set ea_num_generations=30
+  --checkpoint-every 4 --select best-guidance --kill-after-generation 13 -o "${killed}" RESULT_VARIABLE rc
+  OUTPUT_QUIET ERROR_QUIET)
+if(rc STREQUAL "0" OR EXISTS "${killed}/front.csv" OR NOT EXISTS "${killed}/checkpoint.bin")
+  message(FATAL_ERROR "register --kill-after-generation: the run was not killed after its checkpoint (exit '${rc}')")
+endif()
+morea_ok("register --resume" register --problem "${phantom}" ${tiny} --set ea_num_generations=30
+  --checkpoint-every 4 --select best-guidance --resume -o "${killed}")
+if(NOT MOREA_STDOUT MATCHES "resumed from generation 12")
+  message(FATAL_ERROR "register --resume: did not resume:\n${MOREA_STDOUT}")
+endif()
+file(READ "${full}/front.csv" front_full)
+file(READ "${killed}/front.csv" front_resumed)
+if(NOT front_full STREQUAL front_resumed)
+  message(FATAL_ERROR "register --resume: the front differs from the uninterrupted run's\n--- uninterrupted:\n"
+                      "${front_full}\n--- resumed:\n${front_resumed}")
+endif()
+message(STATUS "register: killed after generation 13, resumed from the checkpoint of 12; same front")
+
 message(STATUS "cli.end_to_end: all checks passed")
