@@ -77,13 +77,14 @@ AddDemoCommand(CLI::App & app)
     // A configuration that finishes in a few minutes on 2 cores; any key given
     // on the command line or in a parameter file wins.
     for (const auto & [key, value] : std::vector<std::pair<std::string, std::string>>{
-           { "ea_population_size", "32" },
-           { "ea_num_clusters", "3" },
+           { "ea_population_size", "48" },
+           { "ea_num_clusters", "4" },
            { "ea_archive_size", "200" },
-           { "ea_num_generations", "30" },
-           { "ea_adaptive_steering_activated_at_num_generations", "15" },
+           { "ea_num_generations", "160" },
+           { "ea_adaptive_steering_activated_at_num_generations", "80" },
            { "morea_mesh_num_points", "300" },
            { "morea_sampling_rate", "0.5" },
+           { "seed", "1" },
            { "preprocess_isotropic_spacing", "3.0" } })
       if (!parameters.IsExplicit(key))
         parameters.SetFromString(key, value);
