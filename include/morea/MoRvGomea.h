@@ -180,8 +180,9 @@ private:
   ForcedImprovement(std::size_t solution, int singleObjective, RandomGenerator & random, GenerationRecord & record);
   bool
   InsertIntoArchive(std::size_t solution, const Fitness & fitness);
+  /** `counters` (accepted, repaired, ..., seconds) completed with the archive's state. */
   GenerationRecord
-  Summarise(std::size_t generation) const;
+  Summarise(std::size_t generation, GenerationRecord counters) const;
 
   const TetrahedralMesh &   m_Base;
   const MeshTopology &      m_Topology;

@@ -21,6 +21,9 @@ constexpr double      MultiplierMaximum = 10.0;
 constexpr double      StandardDeviationRatioThreshold = 1.0;
 constexpr double      AmsDelta = 2.0;
 constexpr std::size_t KMeansIterations = 3;
+// Generations without improvement tolerated: 25 + the number of variables
+// (per distribution; per solution that of an edge element, 12).
+constexpr std::size_t NoImprovementStretchBase = 25;
 // A steering violation must rank before any fold: folds are the hard constraint.
 constexpr double FoldConstraintOffset = 1.0e12;
 
@@ -38,6 +41,32 @@ SquaredDistance(const ObjectiveVector & a, const ObjectiveVector & b)
     s += (a[m] - b[m]) * (a[m] - b[m]);
   return s;
 }
+
+/** Per-objective range of a set of solutions, mapping objectives to [0, 1]. */
+struct ObjectiveRange
+{
+  ObjectiveVector low, high;
+
+  ObjectiveRange(const std::vector<std::size_t> & members, const std::vector<Fitness> & fitness)
+  {
+    low.fill(std::numeric_limits<double>::infinity());
+    high.fill(-std::numeric_limits<double>::infinity());
+    for (std::size_t s : members)
+      for (std::size_t m = 0; m < NumberOfObjectives; ++m)
+      {
+        low[m] = std::min(low[m], fitness[s].objectives[m]);
+        high[m] = std::max(high[m], fitness[s].objectives[m]);
+      }
+  }
+  ObjectiveVector
+  Normalise(const Fitness & f) const
+  {
+    ObjectiveVector v;
+    for (std::size_t m = 0; m < NumberOfObjectives; ++m)
+      v[m] = Normalised(f.objectives[m], low[m], high[m]);
+    return v;
+  }
+};
 
 /** Lower Cholesky factor of the n x n matrix `a` (row-major), regularised
  *  on the diagonal until it exists (pinned coordinates have zero variance). */
@@ -263,13 +292,12 @@ MoRvGomea::Initialize(std::vector<DualMesh> population)
   }
   for (std::size_t m = 0; m < NumberOfObjectives; ++m)
     m_Reference[m] = worst[m] > 0.0 ? 1.1 * worst[m] : 1.0;
-  m_History.push_back(Summarise(0));
+  m_History.push_back(Summarise(0, GenerationRecord{}));
 }
 
 GenerationRecord
-MoRvGomea::Summarise(std::size_t generation) const
+MoRvGomea::Summarise(std::size_t generation, GenerationRecord r) const
 {
-  GenerationRecord r;
   r.generation = generation;
   r.archiveSize = m_Archive->Size();
   std::vector<ObjectiveVector> points;
@@ -326,21 +354,8 @@ MoRvGomea::Select(const std::vector<Fitness> & fitness, RandomGenerator & random
     std::vector<std::size_t> front;
     for (std::size_t j = i; j < n && ranks[order[j]] == ranks[order[i]]; ++j)
       front.push_back(order[j]);
-    ObjectiveVector low, high;
-    low.fill(std::numeric_limits<double>::infinity());
-    high.fill(-std::numeric_limits<double>::infinity());
-    for (std::size_t s : front)
-      for (std::size_t m = 0; m < NumberOfObjectives; ++m)
-      {
-        low[m] = std::min(low[m], fitness[s].objectives[m]);
-        high[m] = std::max(high[m], fitness[s].objectives[m]);
-      }
-    auto norm = [&](std::size_t s) {
-      ObjectiveVector v;
-      for (std::size_t m = 0; m < NumberOfObjectives; ++m)
-        v[m] = Normalised(fitness[s].objectives[m], low[m], high[m]);
-      return v;
-    };
+    const ObjectiveRange range(front, fitness);
+    auto                 norm = [&](std::size_t s) { return range.Normalise(fitness[s]); };
     std::vector<double> nearest(front.size(), std::numeric_limits<double>::infinity());
     std::vector<bool>   taken(front.size(), false);
     std::size_t         pick = static_cast<std::size_t>(random.Uniform() * static_cast<double>(front.size()));
@@ -372,21 +387,10 @@ MoRvGomea::BuildClusters(const std::vector<std::size_t> & selection, const std::
                          RandomGenerator & random)
 {
   // Normalised objective space of the selection.
-  ObjectiveVector low, high;
-  low.fill(std::numeric_limits<double>::infinity());
-  high.fill(-std::numeric_limits<double>::infinity());
-  for (std::size_t s : selection)
-    for (std::size_t m = 0; m < NumberOfObjectives; ++m)
-    {
-      low[m] = std::min(low[m], fitness[s].objectives[m]);
-      high[m] = std::max(high[m], fitness[s].objectives[m]);
-    }
-  auto norm = [&](std::size_t s) {
-    ObjectiveVector v;
-    for (std::size_t m = 0; m < NumberOfObjectives; ++m)
-      v[m] = Normalised(fitness[s].objectives[m], low[m], high[m]);
-    return v;
-  };
+  const ObjectiveRange range(selection, fitness);
+  const ObjectiveVector & low = range.low;
+  const ObjectiveVector & high = range.high;
+  auto norm = [&](std::size_t s) { return range.Normalise(fitness[s]); };
   std::vector<ObjectiveVector> points;
   for (std::size_t s : selection)
     points.push_back(norm(s));
@@ -578,6 +582,11 @@ MoRvGomea::ProcessCandidates(std::vector<Candidate> & candidates, GenerationReco
     const FosElement & element = m_Parallel.elements[c.element];
     const DualMesh &   parent = m_Population[c.solution];
     ++record.candidates;
+    PartialCandidate p;
+    p.parent = &parent;
+    p.element = &element;
+    p.source = c.source.data(); // stays valid: the repair below assigns in place
+    p.target = c.target.data();
     for (int side = 0; side < 2; ++side)
     {
       const std::vector<Vec3> & from = side == 0 ? parent.source : parent.target;
@@ -585,19 +594,12 @@ MoRvGomea::ProcessCandidates(std::vector<Candidate> & candidates, GenerationReco
       bool                      folded = false;
       for (std::uint32_t t : element.dependentTetrahedra)
       {
-        Corners corners;
-        for (int v = 0; v < 4; ++v)
-        {
-          const auto it = std::find(element.points.begin(), element.points.end(), tets[t][v]);
-          corners[v] = it == element.points.end() ? from[tets[t][v]] : moved[it - element.points.begin()];
-        }
-        bool f = false;
-        m_Constraint.TetrahedronViolation(t, corners[0], corners[1], corners[2], corners[3], f);
-        if (f)
-        {
-          folded = true;
+        Corners source, target;
+        CandidateCorners(p, tets[t], source, target);
+        const Corners & corners = side == 0 ? source : target;
+        m_Constraint.TetrahedronViolation(t, corners[0], corners[1], corners[2], corners[3], folded);
+        if (folded)
           break;
-        }
       }
       if (folded && !c.folded)
         ++record.folded;
@@ -620,11 +622,6 @@ MoRvGomea::ProcessCandidates(std::vector<Candidate> & candidates, GenerationReco
     if (c.folded && std::llround(m_Totals[c.solution].sum.folded) == 0)
       continue;
     c.values.resize(element.dependentTetrahedra.size());
-    PartialCandidate p;
-    p.parent = &parent;
-    p.element = &element;
-    p.source = c.source.data();
-    p.target = c.target.data();
     p.values = c.values.data();
     batch.push_back(p);
     batchIndex.push_back(i);
@@ -852,7 +849,7 @@ MoRvGomea::RunGeneration()
     {
       DistributionState & state = m_Distributions[c][e];
       const std::size_t   dim = clusters[c].means[e].size();
-      const std::size_t   maxStretch = 25 + dim;
+      const std::size_t   maxStretch = NoImprovementStretchBase + dim;
       if (acceptedCount[c][e] > 0)
       {
         // SDR: the accepted samples' mean in standard deviations of the model.
@@ -889,7 +886,7 @@ MoRvGomea::RunGeneration()
   }
 
   // Forced improvements for solutions stalled too long.
-  const std::size_t maxStretch = 25 + 6 * 2;
+  const std::size_t maxStretch = NoImprovementStretchBase + 12;
   for (std::size_t s = 0; s < m_Population.size(); ++s)
   {
     m_NoImprovement[s] = improved[s] ? 0 : m_NoImprovement[s] + 1;
@@ -906,14 +903,8 @@ MoRvGomea::RunGeneration()
     EvaluatePopulationFully();
     record.tetrahedronEvaluations += n * static_cast<double>(m_Topology.NumberOfTetrahedra());
   }
-  GenerationRecord summary = Summarise(m_Generation);
-  summary.accepted = record.accepted;
-  summary.repaired = record.repaired;
-  summary.candidates = record.candidates;
-  summary.folded = record.folded;
-  summary.forcedImprovements = record.forcedImprovements;
-  summary.tetrahedronEvaluations = record.tetrahedronEvaluations;
-  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  record.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  GenerationRecord summary = Summarise(m_Generation, record);
   m_History.push_back(summary);
 }
 
