@@ -11,6 +11,7 @@
 
 #include "itkMeshModel.h"
 #include "itkRegistrationProblem.h"
+#include "morea/EvaluationBackend.h"
 #include "morea/MoRvGomea.h"
 
 #include <functional>
@@ -34,7 +35,9 @@ struct MeshRegistrationOptions
   std::size_t checkpointInterval{ 0 };
   /** Continue from `checkpointPath` when it exists. */
   bool        resume{ false };
-  std::size_t threads{ 0 }; ///< CPU backend threads; 0: all
+  std::size_t threads{ 0 }; ///< CPU backend threads (CUDA: host threads packing batches); 0: all
+  /** Which evaluation backend: the CPU, CUDA, or CUDA when a device is present. */
+  ::morea::BackendChoice backend{ ::morea::BackendChoice::Cpu };
   /** After each generation (also the resumed ones' replay is not called). May throw to abort. */
   std::function<void(const ::morea::GenerationRecord &, std::size_t generations)> onGeneration;
 };

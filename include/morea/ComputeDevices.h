@@ -31,6 +31,16 @@ ListCudaDevices();
 /** Why ListCudaDevices() is empty, or "" when it is not. */
 std::string
 CudaUnavailableReason();
+/** Bytes of device 0's memory in use (total - free); 0 without a device. */
+std::size_t
+CudaMemoryInUse();
+
+/** Hardware-filtered trilinear fetches per second from a 3D float texture
+ *  on device 0 when neighbouring threads read neighbouring points: the
+ *  coherent best case the tetrahedron kernels are measured against. Throws
+ *  morea::Error without a device. */
+double
+MeasureTrilinearFetchRate();
 } // namespace morea
 
 #endif

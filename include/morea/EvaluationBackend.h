@@ -10,6 +10,7 @@
 #include "morea/TetrahedronObjectives.h"
 
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -27,10 +28,26 @@ struct PartialCandidate
   TetrahedronValues * values{ nullptr };
 };
 
+/** Work a backend has done since it was made (for benchmarks and logs). */
+struct BackendStatistics
+{
+  std::uint64_t batches{ 0 };       ///< EvaluateSolutions and EvaluatePartials calls
+  std::uint64_t tetrahedra{ 0 };    ///< tetrahedra evaluated (both directions each)
+  double        samples{ 0.0 };     ///< sample points drawn, both directions
+  double        seconds{ 0.0 };     ///< wall time inside the calls
+  double        kernelSeconds{ 0.0 }; ///< device time of the kernels (CUDA only)
+};
+
 class EvaluationBackend
 {
 public:
   virtual ~EvaluationBackend() = default;
+
+  const BackendStatistics &
+  Statistics() const
+  {
+    return m_Statistics;
+  }
 
   /** "cpu" or "cuda". */
   virtual std::string
@@ -45,11 +62,35 @@ public:
   /** The dependent tetrahedra of every candidate, each with its moved points. */
   virtual void
   EvaluatePartials(const std::vector<PartialCandidate> & candidates) = 0;
+
+protected:
+  BackendStatistics m_Statistics;
 };
 
 /** The CPU backend over `threads` threads (0: all hardware threads). */
 std::unique_ptr<EvaluationBackend>
 CreateCpuEvaluationBackend(const TetrahedronEvaluator & evaluator, std::size_t threads = 0);
+
+/** The CUDA backend on device 0 (`threads` host threads pack and unpack the
+ *  batches). Throws morea::Error when the build has no CUDA or no device is
+ *  present, and names out-of-memory as such. */
+std::unique_ptr<EvaluationBackend>
+CreateCudaEvaluationBackend(const TetrahedronEvaluator & evaluator, std::size_t threads = 0);
+
+enum class BackendChoice
+{
+  Cpu,
+  Cuda,
+  Auto ///< CUDA when a device is present, else the CPU
+};
+
+/** "cpu", "cuda" or "auto"; anything else is an error. */
+BackendChoice
+ParseBackendChoice(const std::string & name);
+
+/** The one place that picks the platform. */
+std::unique_ptr<EvaluationBackend>
+CreateEvaluationBackend(BackendChoice choice, const TetrahedronEvaluator & evaluator, std::size_t threads = 0);
 
 /** Corners of tetrahedron `t` in a parent whose element points are replaced. */
 void

@@ -2,6 +2,14 @@
 // folded where a tetrahedron's signed volume no longer has the sign it had in
 // the base mesh; the constraint value is the sum of the folded tetrahedra's
 // |signed volume| over both meshes. Feasible means no folded tetrahedron.
+//
+// An optional volume fraction f > 0 tightens this: a tetrahedron also counts
+// as folded when its oriented volume leaves [f, 1/f] times its base volume.
+// A mesh can be fold-free while two neighbouring tetrahedra are squeezed
+// almost flat; a displacement field rasterised from it then shows
+// non-positive finite-difference Jacobians where the stencil straddles them.
+// The violation (distance of the volume to the allowed interval) is
+// continuous and equals SPEC 5's |signed volume| when f = 0.
 #ifndef morea_FoldConstraint_h
 #define morea_FoldConstraint_h
 
@@ -36,11 +44,13 @@ struct FoldViolation
 class FoldConstraint
 {
 public:
-  /** Reference signs from the base configuration `reference`. */
-  FoldConstraint(const MeshTopology & topology, const std::vector<Vec3> & reference);
+  /** Reference volumes from the base configuration `reference`;
+   *  `volumeFraction` in [0, 1) (0: sign changes only, SPEC 5). */
+  FoldConstraint(const MeshTopology & topology, const std::vector<Vec3> & reference, double volumeFraction = 0.0);
 
-  /** |signed volume| of tetrahedron t in `points` when folded (a zero volume
-   *  counts as folded with severity 0), else 0; `folded` tells which. */
+  /** How far tetrahedron t's volume in `points` lies outside the allowed
+   *  interval (|signed volume| of a sign change when the fraction is 0; a zero
+   *  volume counts as folded with severity 0), else 0; `folded` tells which. */
   double
   TetrahedronViolation(std::size_t t, const std::vector<Vec3> & points, bool & folded) const;
 
@@ -70,10 +80,26 @@ public:
   {
     return *m_Topology;
   }
+  double
+  VolumeFraction() const
+  {
+    return m_VolumeFraction;
+  }
+  /** Signed volume of each tetrahedron in the base mesh. */
+  const std::vector<double> &
+  ReferenceVolumes() const
+  {
+    return m_ReferenceVolumes;
+  }
 
 private:
-  const MeshTopology *     m_Topology;
-  std::vector<std::int8_t> m_ReferenceSigns;
+  /** The violation of one tetrahedron whose signed volume is `v`. */
+  double
+  VolumeViolation(std::size_t t, double v, bool & folded) const;
+
+  const MeshTopology * m_Topology;
+  std::vector<double>  m_ReferenceVolumes;
+  double               m_VolumeFraction{ 0.0 };
 };
 } // namespace morea
 

@@ -81,6 +81,17 @@ public:
   {
     return *m_Data;
   }
+  const FoldConstraint &
+  Constraint() const
+  {
+    return *m_Constraint;
+  }
+  /** One factor per tetrahedron, or empty (all 1). */
+  const std::vector<double> &
+  Elasticity() const
+  {
+    return *m_Elasticity;
+  }
 
 private:
   /** Samples drawn in `from` (seeded by its coordinates), mapped to `to`;

@@ -29,6 +29,11 @@ private:
   std::uint32_t                m_Index{ 0 };
 };
 
+/** The direction numbers ScrambledSobol4 uses: 4 dimensions x 32 bits,
+ *  row-major (a CUDA backend copies them to reproduce the same samples). */
+const std::uint32_t *
+SobolDirectionNumbers();
+
 /** A seed from the exact bit patterns of the four corners. */
 std::uint64_t
 TetrahedronSeed(const Vec3 & a, const Vec3 & b, const Vec3 & c, const Vec3 & d);

@@ -87,6 +87,9 @@ void
 AddRegisterCommand(CLI::App & app);
 void
 AddDemoCommand(CLI::App & app);
+/** `morea benchmark` */
+void
+AddBenchmarkCommand(CLI::App & app);
 void
 AddInfoCommand(CLI::App & app);
 } // namespace morea::cli

@@ -86,7 +86,8 @@ AddMeshCommand(CLI::App & app)
     if (options->samples > 0)
     {
       const auto                  start = std::chrono::steady_clock::now();
-      const ::morea::FoldConstraint constraint(model.topology, model.base.points);
+      const ::morea::FoldConstraint constraint(model.topology, model.base.points,
+                                                parameters.GetReal("morea_fold_volume_fraction"));
       const auto population = ::morea::GenerateInitialPopulation(
         model.base, constraint, options->samples + 1, static_cast<std::uint64_t>(parameters.GetInteger("seed")),
         ::morea::InitialPopulationOptions::FromParameters(parameters));

@@ -28,6 +28,7 @@ AddRegisterCommand(CLI::App & app)
     std::size_t      checkpointEvery{ 10 };
     bool             resume{ false };
     std::size_t      threads{ 0 };
+    std::string      backend{ "auto" };
     std::size_t      killAfter{ 0 };
   };
   auto   options = std::make_shared<Options>();
@@ -43,6 +44,9 @@ AddRegisterCommand(CLI::App & app)
     ->capture_default_str();
   cmd->add_flag("--resume", options->resume, "continue from output/checkpoint.bin when it exists");
   cmd->add_option("--threads", options->threads, "CPU threads (0: all)")->capture_default_str();
+  cmd->add_option("--backend", options->backend, "evaluation backend: cpu, cuda, or auto (CUDA when a device is present)")
+    ->check(CLI::IsMember({ "cpu", "cuda", "auto" }))
+    ->capture_default_str();
   // For crash-recovery tests: the process kills itself (SIGKILL) right after
   // generation N, as an external kill would, leaving only the checkpoint.
   cmd->add_option("--kill-after-generation", options->killAfter)->group("");
@@ -66,6 +70,7 @@ AddRegisterCommand(CLI::App & app)
     run.checkpointInterval = options->checkpointEvery;
     run.resume = options->resume;
     run.threads = options->threads;
+    run.backend = ::morea::ParseBackendChoice(options->backend);
     run.onGeneration = [print = ProgressPrinter(), killAfter = options->killAfter](
                          const ::morea::GenerationRecord & r, std::size_t total) {
       print(r, total);
@@ -77,7 +82,7 @@ AddRegisterCommand(CLI::App & app)
       std::cout << "resumed from generation " << result.resumedAtGeneration << "\n";
     std::cout << "mesh " << result.model.base.NumberOfPoints() << " points, " << result.model.base.NumberOfTetrahedra()
               << " tetrahedra (" << result.secondsModel << " s); optimisation " << result.secondsOptimisation
-              << " s on " << result.threads << " " << result.backend << " threads; front of " << result.front.size()
+              << " s on the " << result.backend << " backend (" << result.threads << " threads); front of " << result.front.size()
               << "\n";
 
     const auto chosen = ChooseSolutions(result.front, options->select);

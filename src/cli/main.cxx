@@ -18,6 +18,7 @@ main(int argc, char ** argv)
   morea::cli::AddMeshCommand(app);
   morea::cli::AddRegisterCommand(app);
   morea::cli::AddDemoCommand(app);
+  morea::cli::AddBenchmarkCommand(app);
   morea::cli::AddInfoCommand(app);
   try
   {

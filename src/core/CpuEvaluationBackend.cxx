@@ -7,6 +7,7 @@
 #include "morea/ThreadPool.h"
 
 #include <algorithm>
+#include <chrono>
 
 namespace morea
 {
@@ -63,6 +64,7 @@ public:
     }
     // Chunks of tetrahedra across all solutions keep every thread busy even
     // for a single solution.
+    const auto            start = std::chrono::steady_clock::now();
     constexpr std::size_t chunk = 64;
     const std::size_t     chunksPerSolution = (tets + chunk - 1) / chunk;
     m_Pool.ParallelFor(solutions.size() * chunksPerSolution, [&](std::size_t job) {
@@ -72,11 +74,16 @@ public:
       for (std::size_t t = begin; t < end; ++t)
         (*values[s])[t] = m_Evaluator.Evaluate(t, *solutions[s]);
     });
+    ++m_Statistics.batches;
+    for (const auto * v : values)
+      Count(*v);
+    m_Statistics.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
 
   void
   EvaluatePartials(const std::vector<PartialCandidate> & candidates) override
   {
+    const auto   start = std::chrono::steady_clock::now();
     const auto & tets = m_Evaluator.Topology().Tetrahedra();
     m_Pool.ParallelFor(candidates.size(), [&](std::size_t i) {
       const PartialCandidate & c = candidates[i];
@@ -88,9 +95,25 @@ public:
         c.values[k] = m_Evaluator.Evaluate(dependent[k], source, target);
       }
     });
+    ++m_Statistics.batches;
+    for (const PartialCandidate & c : candidates)
+    {
+      m_Statistics.tetrahedra += c.element->dependentTetrahedra.size();
+      for (std::size_t k = 0; k < c.element->dependentTetrahedra.size(); ++k)
+        m_Statistics.samples += c.values[k].samples;
+    }
+    m_Statistics.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
 
 private:
+  void
+  Count(const std::vector<TetrahedronValues> & values)
+  {
+    m_Statistics.tetrahedra += values.size();
+    for (const auto & v : values)
+      m_Statistics.samples += v.samples;
+  }
+
   const TetrahedronEvaluator & m_Evaluator;
   ThreadPool                   m_Pool;
 };

@@ -6,37 +6,58 @@
 
 namespace morea
 {
-FoldConstraint::FoldConstraint(const MeshTopology & topology, const std::vector<Vec3> & reference)
+FoldConstraint::FoldConstraint(const MeshTopology & topology, const std::vector<Vec3> & reference,
+                               double volumeFraction)
   : m_Topology(&topology)
+  , m_VolumeFraction(volumeFraction)
 {
+  if (!(volumeFraction >= 0.0 && volumeFraction < 1.0))
+    throw Error("fold constraint: the volume fraction must lie in [0, 1), not " + std::to_string(volumeFraction));
   if (reference.size() != topology.NumberOfPoints())
     throw Error("fold constraint: reference has " + std::to_string(reference.size()) + " points, the mesh " +
                 std::to_string(topology.NumberOfPoints()));
-  m_ReferenceSigns.reserve(topology.NumberOfTetrahedra());
+  m_ReferenceVolumes.reserve(topology.NumberOfTetrahedra());
   for (const Tetrahedron & t : topology.Tetrahedra())
   {
     const double v = SignedVolume(t, reference);
     if (v == 0.0)
       throw Error("fold constraint: the base mesh has a flat tetrahedron");
-    m_ReferenceSigns.push_back(v > 0.0 ? 1 : -1);
+    m_ReferenceVolumes.push_back(v);
   }
+}
+
+double
+FoldConstraint::VolumeViolation(std::size_t t, double v, bool & folded) const
+{
+  const double reference = m_ReferenceVolumes[t];
+  const double size = std::abs(reference);
+  const double oriented = reference > 0.0 ? v : -v; // positive while unfolded
+  const double lower = m_VolumeFraction * size;
+  if (!(oriented > lower))
+  {
+    folded = true;
+    return lower - oriented;
+  }
+  if (m_VolumeFraction > 0.0 && oriented * m_VolumeFraction > size)
+  {
+    folded = true;
+    return oriented - size / m_VolumeFraction;
+  }
+  folded = false;
+  return 0.0;
 }
 
 double
 FoldConstraint::TetrahedronViolation(std::size_t t, const std::vector<Vec3> & points, bool & folded) const
 {
-  const double v = SignedVolume(m_Topology->Tetrahedra()[t], points);
-  folded = !(v * m_ReferenceSigns[t] > 0.0);
-  return folded ? std::abs(v) : 0.0;
+  return VolumeViolation(t, SignedVolume(m_Topology->Tetrahedra()[t], points), folded);
 }
 
 double
 FoldConstraint::TetrahedronViolation(std::size_t t, const Vec3 & a, const Vec3 & b, const Vec3 & c, const Vec3 & d,
                                      bool & folded) const
 {
-  const double v = SignedVolume(a, b, c, d);
-  folded = !(v * m_ReferenceSigns[t] > 0.0);
-  return folded ? std::abs(v) : 0.0;
+  return VolumeViolation(t, SignedVolume(a, b, c, d), folded);
 }
 
 FoldViolation

@@ -90,6 +90,8 @@ MakeSpecs()
     Text("morea_symmetry_mode", "transform-both", { "transform-both" }, "objectives in both directions"),
     Text("morea_dual_dynamic_mode", "dual", { "dual" }, "both meshes' points are variables"),
     Text("morea_repair_method", "gaussian", { "gaussian", "none" }, "repair of folded solutions"),
+    Real("morea_fold_volume_fraction", 0.0, 0.0, 0.99,
+         "a tetrahedron also counts as folded when its volume leaves [f, 1/f] times its base volume (0: sign only)"),
     Text("morea_ams_strategy", "none", { "none" }, "anticipated mean shift variant"),
     Int("morea_num_disruption_kernels", 0, 0, 0, "disruption kernels (not used by MOREA)"),
     Int("morea_disruption_frequency", 0, 0, 0, "disruption frequency (not used by MOREA)"),

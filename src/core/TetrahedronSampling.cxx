@@ -49,6 +49,12 @@ Directions()
 }
 } // namespace
 
+const std::uint32_t *
+SobolDirectionNumbers()
+{
+  return &Directions().v[0][0];
+}
+
 ScrambledSobol4::ScrambledSobol4(std::uint64_t seed)
 {
   RandomGenerator random(seed);

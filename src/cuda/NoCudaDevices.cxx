@@ -1,5 +1,7 @@
 // CPU-only builds: there is no CUDA backend to offer.
 #include "morea/ComputeDevices.h"
+#include "morea/Error.h"
+#include "morea/EvaluationBackend.h"
 
 namespace morea
 {
@@ -19,5 +21,23 @@ std::string
 CudaUnavailableReason()
 {
   return "this build has no CUDA backend (nvcc was not found when it was configured)";
+}
+
+std::size_t
+CudaMemoryInUse()
+{
+  return 0;
+}
+
+double
+MeasureTrilinearFetchRate()
+{
+  throw Error("fetch-rate probe: " + CudaUnavailableReason());
+}
+
+std::unique_ptr<EvaluationBackend>
+CreateCudaEvaluationBackend(const TetrahedronEvaluator &, std::size_t)
+{
+  throw Error("CUDA backend: " + CudaUnavailableReason());
 }
 } // namespace morea

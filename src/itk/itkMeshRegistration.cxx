@@ -26,9 +26,10 @@ RegisterMeshes(const RegistrationProblem & problem, const ::morea::ParameterSet 
   result.model = BuildMeshModel(problem, parameters);
   const MeshModel &             model = result.model;
   const ::morea::ObjectiveData  data = BuildObjectiveData(problem, model, parameters);
-  const ::morea::FoldConstraint constraint(model.topology, model.base.points);
+  const ::morea::FoldConstraint constraint(model.topology, model.base.points,
+                                                parameters.GetReal("morea_fold_volume_fraction"));
   const ::morea::TetrahedronEvaluator evaluator(model.topology, constraint, model.elasticity, data);
-  auto backend = ::morea::CreateCpuEvaluationBackend(evaluator, options.threads);
+  auto backend = ::morea::CreateEvaluationBackend(options.backend, evaluator, options.threads);
   result.backend = backend->Name();
   result.threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
   result.secondsModel = std::chrono::duration<double>(Clock::now() - start).count();

@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# The CUDA benchmark on a GPU machine without ITK (see bench/README.md).
+#   Here:          bench/run-device-benchmark.sh bundle
+#                  builds morea and the core tests (CUDA for sm_90), packs them with
+#                  their libraries and the abdominal CBCT pair into device-carry/.
+#   On the GPU:    bench/run-device-benchmark.sh run OUTDIR [morea benchmark options]
+#                  runs the CPU/CUDA agreement tests, then `morea benchmark` with
+#                  the paper's configuration; logs and JSON go to OUTDIR.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+DATA=${MOREA_DATA:-../shared/data/abdomen-cbct-pair}
+case "${1:-}" in
+  bundle)
+    cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
+    cmake --build build -j"$(nproc)" --target morea MOREACoreTests
+    stage=$(mktemp -d)
+    trap 'rm -rf "$stage"' EXIT
+    mkdir -p "$stage/abdomen/CB07_masks"
+    cp "$DATA"/CB02.mha "$DATA"/CB07.mha "$DATA"/CB02_labels.mha "$DATA"/CB02_labels.txt "$stage/abdomen/"
+    cp "$DATA"/CB07_masks/Stomach_duo_CBCT.mha "$DATA"/CB07_masks/Bowel_sm_CBCT.mha "$stage/abdomen/CB07_masks/"
+    scripts/device-bundle.sh --data "$stage/abdomen" build/bin/morea build/test/MOREACoreTests
+    ;;
+  run)
+    out=${2:?output folder}
+    shift 2
+    mkdir -p "$out" /tmp/b
+    tar xJf device-carry/bundle.tar.xz -C /tmp/b
+    export LD_LIBRARY_PATH=/tmp/b/lib
+    nvidia-smi --query-gpu=name,memory.total,driver_version,clocks.max.sm --format=csv | tee "$out/gpu.txt"
+    /tmp/b/bin/MOREACoreTests --gtest_filter='*Cuda*:*BackendSelection*' 2>&1 | tee "$out/agreement-tests.log" | tail -4
+    D=/tmp/b/data/abdomen
+    /tmp/b/bin/morea benchmark \
+      --fixed "$D/CB02.mha" --moving "$D/CB07.mha" \
+      --fixed-structure Stomach_duo_CBCT="$D/CB02_labels.mha:Stomach_duo_CBCT" \
+      --moving-structure Stomach_duo_CBCT="$D/CB07_masks/Stomach_duo_CBCT.mha" \
+      --fixed-structure Bowel_sm_CBCT="$D/CB02_labels.mha:Bowel_sm_CBCT" \
+      --moving-structure Bowel_sm_CBCT="$D/CB07_masks/Bowel_sm_CBCT.mha" \
+      --parameters bench/configurations/abdomen_paper.toml -o "$out/benchmark.json" "$@" 2>&1 | tee "$out/benchmark.log"
+    ;;
+  *)
+    echo "usage: $0 bundle | run OUTDIR [morea benchmark options]" >&2
+    exit 2
+    ;;
+esac

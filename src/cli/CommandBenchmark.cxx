@@ -1,0 +1,215 @@
+// `morea benchmark`: times MO-RV-GOMEA on a real problem with each evaluation
+// backend (SPEC 6): per-generation wall time, partial evaluations and sample
+// points per second, kernel time, peak GPU memory, the GPU's own coherent
+// trilinear fetch rate as a yardstick, and the CPU backend on the same work.
+#include "CommandCommon.h"
+
+#include "itkMOREAImageIO.h"
+#include "itkMeshModel.h"
+#include "itkObjectiveData.h"
+#include "itkPreprocessing.h"
+#include "morea/ComputeDevices.h"
+#include "morea/EvaluationBackend.h"
+#include "morea/FoldConstraint.h"
+#include "morea/InitialPopulation.h"
+#include "morea/MoRvGomea.h"
+#include "morea/TetrahedronObjectives.h"
+
+#include <algorithm>
+#include <chrono>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <thread>
+
+namespace morea::cli
+{
+namespace
+{
+using Clock = std::chrono::steady_clock;
+
+double
+Since(Clock::time_point start)
+{
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+/** One backend's run: `generations` generations from the seeded start. */
+nlohmann::json
+TimeBackend(BackendChoice choice, const itk::morea::MeshModel & model, const TetrahedronEvaluator & evaluator,
+            const GomeaOptions & gomea, const InitialPopulationOptions & initial, std::size_t generations,
+            std::size_t threads)
+{
+  const std::size_t memoryBefore = CudaMemoryInUse();
+  std::size_t       memoryPeak = memoryBefore;
+  auto              backend = CreateEvaluationBackend(choice, evaluator, threads);
+  std::cout << "  backend " << backend->Name() << ": initial population of " << gomea.populationSize << "\n"
+            << std::flush;
+  auto                 start = Clock::now();
+  std::vector<DualMesh> population =
+    GenerateInitialPopulation(model.base, evaluator.Constraint(), gomea.populationSize, gomea.seed, initial);
+  const double secondsPopulation = Since(start);
+  start = Clock::now();
+  MoRvGomea optimiser(model.base, model.topology, model.parallel, evaluator.Constraint(), *backend, gomea);
+  optimiser.Initialize(std::move(population));
+  const double            secondsInitialEvaluation = Since(start);
+  const BackendStatistics afterInit = backend->Statistics();
+  memoryPeak = std::max(memoryPeak, CudaMemoryInUse());
+
+  nlohmann::json perGeneration = nlohmann::json::array();
+  start = Clock::now();
+  for (std::size_t g = 0; g < generations && !optimiser.Finished(); ++g)
+  {
+    const BackendStatistics before = backend->Statistics();
+    const auto              generationStart = Clock::now();
+    optimiser.RunGeneration();
+    const double            seconds = Since(generationStart);
+    const BackendStatistics after = backend->Statistics();
+    memoryPeak = std::max(memoryPeak, CudaMemoryInUse());
+    const GenerationRecord & r = optimiser.History().back();
+    perGeneration.push_back({ { "generation", r.generation },
+                              { "seconds", seconds },
+                              { "backend_seconds", after.seconds - before.seconds },
+                              { "kernel_seconds", after.kernelSeconds - before.kernelSeconds },
+                              { "tetrahedra", after.tetrahedra - before.tetrahedra },
+                              { "samples", after.samples - before.samples },
+                              { "batches", after.batches - before.batches },
+                              { "best_guidance", r.bestGuidance },
+                              { "hypervolume", r.hypervolume },
+                              { "archive", r.archiveSize } });
+    std::cout << "    generation " << r.generation << ": " << std::fixed << std::setprecision(3) << seconds
+              << " s (backend " << after.seconds - before.seconds << " s, kernels "
+              << after.kernelSeconds - before.kernelSeconds << " s), best guidance " << std::defaultfloat
+              << r.bestGuidance << "\n"
+              << std::flush;
+  }
+  const double            secondsGenerations = Since(start);
+  const BackendStatistics total = backend->Statistics();
+  const double            tetrahedra = static_cast<double>(total.tetrahedra - afterInit.tetrahedra);
+  const double            samples = total.samples - afterInit.samples;
+  const double            kernel = total.kernelSeconds - afterInit.kernelSeconds;
+  const std::size_t       done = perGeneration.size();
+  nlohmann::json          out{ { "backend", backend->Name() },
+                      { "threads", threads ? threads : std::max(1u, std::thread::hardware_concurrency()) },
+                      { "seconds_initial_population", secondsPopulation },
+                      { "seconds_initial_evaluation", secondsInitialEvaluation },
+                      { "generations", done },
+                      { "seconds_generations", secondsGenerations },
+                      { "seconds_per_generation", done ? secondsGenerations / static_cast<double>(done) : 0.0 },
+                      { "seconds_in_backend", total.seconds - afterInit.seconds },
+                      { "seconds_in_kernels", kernel },
+                      { "tetrahedron_evaluations", tetrahedra },
+                      { "samples", samples },
+                      { "tetrahedron_evaluations_per_second", secondsGenerations > 0 ? tetrahedra / secondsGenerations : 0.0 },
+                      { "samples_per_second_wall", secondsGenerations > 0 ? samples / secondsGenerations : 0.0 },
+                      { "samples_per_second_kernel", kernel > 0 ? samples / kernel : 0.0 },
+                      { "gpu_memory_peak_bytes", memoryPeak - memoryBefore },
+                      { "archive_size", optimiser.Archive().Size() },
+                      { "per_generation", perGeneration } };
+  return out;
+}
+} // namespace
+
+void
+AddBenchmarkCommand(CLI::App & app)
+{
+  struct Options
+  {
+    ProblemOptions   problem;
+    ParameterOptions parameters;
+    std::string      output;
+    std::string      backends{ "cuda,cpu" };
+    std::size_t      generations{ 0 };
+    std::size_t      cpuGenerations{ 2 };
+    std::size_t      threads{ 0 };
+    bool             probe{ true };
+  };
+  auto   options = std::make_shared<Options>();
+  auto * cmd = app.add_subcommand("benchmark", "time MO-RV-GOMEA with the CUDA and CPU backends on a problem");
+  options->problem.AddTo(*cmd);
+  options->parameters.AddTo(*cmd);
+  cmd->add_option("-o,--output", options->output, "JSON file for the results")->required();
+  cmd->add_option("--backends", options->backends, "comma-separated: cuda, cpu")->capture_default_str();
+  cmd->add_option("--generations", options->generations, "generations of the CUDA run (0: ea_num_generations)")
+    ->capture_default_str();
+  cmd->add_option("--cpu-generations", options->cpuGenerations, "generations of the CPU run (the same first ones)")
+    ->capture_default_str();
+  cmd->add_option("--threads", options->threads, "CPU threads (0: all)")->capture_default_str();
+  cmd->add_option("--probe", options->probe, "measure the GPU's coherent trilinear fetch rate")->capture_default_str();
+  cmd->callback([options] {
+    const auto parameters = options->parameters.Load();
+    const auto start = Clock::now();
+    const auto input = options->problem.Load();
+    const auto preprocessed = itk::morea::Preprocess(input, itk::morea::PreprocessOptions::FromParameters(parameters));
+    const auto & r = preprocessed.report;
+    const double voxels = static_cast<double>(r.size[0]) * r.size[1] * r.size[2];
+    std::cout << "preprocessed: " << r.size[0] << "x" << r.size[1] << "x" << r.size[2] << " = " << voxels
+              << " voxels of " << r.spacing << " mm (" << Since(start) << " s)\n";
+    auto       modelStart = Clock::now();
+    const auto model = itk::morea::BuildMeshModel(preprocessed.problem, parameters);
+    const ObjectiveData data = itk::morea::BuildObjectiveData(preprocessed.problem, model, parameters);
+    const FoldConstraint constraint(model.topology, model.base.points, parameters.GetReal("morea_fold_volume_fraction"));
+    const TetrahedronEvaluator evaluator(model.topology, constraint, model.elasticity, data);
+    const GomeaOptions         gomea = GomeaOptions::FromParameters(parameters);
+    const auto                 initial = InitialPopulationOptions::FromParameters(parameters);
+    std::cout << "mesh: " << model.base.NumberOfPoints() << " points, " << model.base.NumberOfTetrahedra()
+              << " tetrahedra, " << model.parallel.elements.size() << " FOS elements in "
+              << model.parallel.groups.size() << " parallel groups (" << Since(modelStart) << " s)\n";
+
+    nlohmann::json report{ { "voxels", voxels },
+                           { "size", { r.size[0], r.size[1], r.size[2] } },
+                           { "spacing_mm", r.spacing },
+                           { "mesh_points", model.base.NumberOfPoints() },
+                           { "tetrahedra", model.base.NumberOfTetrahedra() },
+                           { "fos_elements", model.parallel.elements.size() },
+                           { "parallel_groups", model.parallel.groups.size() },
+                           { "population", gomea.populationSize },
+                           { "clusters", gomea.numberOfClusters },
+                           { "archive_capacity", gomea.archiveCapacity },
+                           { "sampling_rate", data.samplingRate },
+                           { "guidance_structures", data.NumberOfGuidanceStructures() } };
+    const auto devices = ListCudaDevices();
+    if (!devices.empty())
+      report["device"] = devices.front().name;
+    if (options->probe && !devices.empty())
+    {
+      const double rate = MeasureTrilinearFetchRate();
+      report["trilinear_fetches_per_second"] = rate;
+      std::cout << "coherent trilinear texture fetches: " << rate << " per second\n";
+    }
+    std::stringstream list(options->backends);
+    for (std::string name; std::getline(list, name, ',');)
+    {
+      const BackendChoice choice = ParseBackendChoice(name);
+      const std::size_t   generations =
+        choice == BackendChoice::Cpu ? options->cpuGenerations : (options->generations ? options->generations : gomea.generations);
+      std::cout << "timing " << name << " for " << generations << " generations\n";
+      report["runs"][name] = TimeBackend(choice, model, evaluator, gomea, initial, generations, options->threads);
+    }
+    if (report.contains("runs") && report["runs"].contains("cuda") && report["runs"].contains("cpu"))
+    {
+      // The same first generations on both: the ratio of their mean times.
+      const auto &      cuda = report["runs"]["cuda"]["per_generation"];
+      const auto &      cpu = report["runs"]["cpu"]["per_generation"];
+      const std::size_t n = std::min(cuda.size(), cpu.size());
+      double            a = 0.0, b = 0.0;
+      for (std::size_t i = 0; i < n; ++i)
+      {
+        a += cuda[i]["seconds"].get<double>();
+        b += cpu[i]["seconds"].get<double>();
+      }
+      if (n > 0 && a > 0.0)
+      {
+        report["cpu_over_cuda_same_generations"] = b / a;
+        report["compared_generations"] = n;
+        std::cout << "CPU (" << report["runs"]["cpu"]["threads"] << " threads) / CUDA time over the first " << n
+                  << " generations: " << b / a << "\n";
+      }
+    }
+    itk::morea::WriteTextFile(report.dump(2) + "\n", options->output);
+    std::cout << "wrote " << options->output << "\n";
+  });
+}
+} // namespace morea::cli

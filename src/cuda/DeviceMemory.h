@@ -1,0 +1,175 @@
+// RAII owners for CUDA device and pinned host memory, and the one place that
+// turns a CUDA status into an exception. Private to src/cuda: nothing outside
+// the CUDA library sees CUDA headers.
+#ifndef morea_cuda_DeviceMemory_h
+#define morea_cuda_DeviceMemory_h
+
+#include "morea/Error.h"
+
+#include <cuda_runtime.h>
+
+#include <cstddef>
+#include <string>
+#include <utility>
+
+namespace morea::cuda
+{
+/** Throws morea::Error naming `what` when `status` is not cudaSuccess. */
+inline void
+Check(cudaError_t status, const char * what)
+{
+  if (status == cudaSuccess)
+    return;
+  cudaGetLastError(); // clear a non-sticky error so that later calls can go on
+  if (status == cudaErrorMemoryAllocation)
+    throw Error(std::string("CUDA backend: out of GPU memory (") + what + ")");
+  throw Error(std::string("CUDA backend: ") + what + ": " + cudaGetErrorString(status));
+}
+
+/** Device memory for `count` elements of T; grows on demand, never shrinks. */
+template <typename T>
+class DeviceArray
+{
+public:
+  DeviceArray() = default;
+  explicit DeviceArray(std::size_t count) { Reserve(count); }
+  ~DeviceArray() { Release(); }
+  DeviceArray(const DeviceArray &) = delete;
+  DeviceArray &
+  operator=(const DeviceArray &) = delete;
+  DeviceArray(DeviceArray && o) noexcept
+    : m_Data(std::exchange(o.m_Data, nullptr))
+    , m_Capacity(std::exchange(o.m_Capacity, 0))
+  {}
+
+  /** At least `count` elements; the old contents are lost when it grows. */
+  void
+  Reserve(std::size_t count)
+  {
+    if (count <= m_Capacity)
+      return;
+    Release();
+    const std::size_t bytes = count * sizeof(T);
+    void *            p = nullptr;
+    Check(cudaMalloc(&p, bytes), (std::to_string(bytes >> 20) + " MiB of device memory").c_str());
+    m_Data = static_cast<T *>(p);
+    m_Capacity = count;
+  }
+  T *
+  Data() const
+  {
+    return m_Data;
+  }
+  std::size_t
+  Capacity() const
+  {
+    return m_Capacity;
+  }
+
+private:
+  void
+  Release() noexcept
+  {
+    if (m_Data)
+      cudaFree(m_Data); // errors at release cannot be reported usefully
+    m_Data = nullptr;
+    m_Capacity = 0;
+  }
+  T *         m_Data{ nullptr };
+  std::size_t m_Capacity{ 0 };
+};
+
+/** Page-locked host memory (fast asynchronous copies); grows on demand. */
+template <typename T>
+class PinnedArray
+{
+public:
+  PinnedArray() = default;
+  ~PinnedArray() { Release(); }
+  PinnedArray(const PinnedArray &) = delete;
+  PinnedArray &
+  operator=(const PinnedArray &) = delete;
+
+  void
+  Reserve(std::size_t count)
+  {
+    if (count <= m_Capacity)
+      return;
+    Release();
+    const std::size_t bytes = count * sizeof(T);
+    void *            p = nullptr;
+    Check(cudaMallocHost(&p, bytes), (std::to_string(bytes >> 20) + " MiB of pinned host memory").c_str());
+    m_Data = static_cast<T *>(p);
+    m_Capacity = count;
+  }
+  T *
+  Data() const
+  {
+    return m_Data;
+  }
+  T &
+  operator[](std::size_t i) const
+  {
+    return m_Data[i];
+  }
+
+private:
+  void
+  Release() noexcept
+  {
+    if (m_Data)
+      cudaFreeHost(m_Data);
+    m_Data = nullptr;
+    m_Capacity = 0;
+  }
+  T *         m_Data{ nullptr };
+  std::size_t m_Capacity{ 0 };
+};
+
+/** A CUDA stream owned for the lifetime of the object. */
+class Stream
+{
+public:
+  Stream() { Check(cudaStreamCreateWithFlags(&m_Stream, cudaStreamNonBlocking), "creating a stream"); }
+  ~Stream()
+  {
+    if (m_Stream)
+      cudaStreamDestroy(m_Stream);
+  }
+  Stream(const Stream &) = delete;
+  Stream &
+  operator=(const Stream &) = delete;
+  cudaStream_t
+  Get() const
+  {
+    return m_Stream;
+  }
+
+private:
+  cudaStream_t m_Stream{ nullptr };
+};
+/** A CUDA event (timing only) owned for the lifetime of the object. */
+class Event
+{
+public:
+  Event() { Check(cudaEventCreate(&m_Event), "creating an event"); }
+  ~Event()
+  {
+    if (m_Event)
+      cudaEventDestroy(m_Event);
+  }
+  Event(const Event &) = delete;
+  Event &
+  operator=(const Event &) = delete;
+  cudaEvent_t
+  Get() const
+  {
+    return m_Event;
+  }
+
+private:
+  cudaEvent_t m_Event{ nullptr };
+};
+} // namespace morea::cuda
+
+#endif

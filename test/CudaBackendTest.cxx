@@ -1,0 +1,235 @@
+// The CUDA evaluation backend against the CPU reference (SPEC 6): the same
+// solutions and the same partial candidates give the same per-tetrahedron
+// values (sample counts and folds exactly, objectives to relative 1e-4), and
+// a short seeded run gives a front of the same quality. The GPU tests skip
+// themselves when no CUDA device is present; the selection tests run anywhere.
+#include "OptimiserTestProblem.h"
+
+#include "morea/ComputeDevices.h"
+#include "morea/Error.h"
+#include "morea/Random.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+using namespace morea;
+using morea_test::OptimiserTestProblem;
+
+namespace
+{
+#define MOREA_REQUIRE_CUDA_DEVICE()                                                                                    \
+  if (!CudaUnavailableReason().empty())                                                                                \
+  GTEST_SKIP() << CudaUnavailableReason()
+
+void
+ExpectRelativelyClose(double cpu, double cuda, double tolerance, const std::string & what)
+{
+  EXPECT_LE(std::abs(cpu - cuda), tolerance * std::max(std::abs(cpu), 1e-12)) << what << ": cpu " << cpu << " cuda "
+                                                                               << cuda;
+}
+
+void
+ExpectSameTotals(const std::vector<TetrahedronValues> & cpu, const std::vector<TetrahedronValues> & cuda,
+                 const std::string & what)
+{
+  ASSERT_EQ(cpu.size(), cuda.size());
+  ObjectiveTotals a, b;
+  for (std::size_t t = 0; t < cpu.size(); ++t)
+  {
+    // Sample counts and fold decisions are exact: they depend only on volumes
+    // computed with the same rounding.
+    EXPECT_EQ(cpu[t].samples, cuda[t].samples) << what << " tetrahedron " << t;
+    EXPECT_EQ(cpu[t].folded, cuda[t].folded) << what << " tetrahedron " << t;
+    ExpectRelativelyClose(cpu[t].magnitude, cuda[t].magnitude, 1e-9, what + " magnitude");
+    ExpectRelativelyClose(cpu[t].foldValue, cuda[t].foldValue, 1e-9, what + " fold value");
+    a.Add(cpu[t]);
+    b.Add(cuda[t]);
+  }
+  const Fitness fa = a.ToFitness(cpu.size()), fb = b.ToFitness(cuda.size());
+  for (std::size_t m = 0; m < NumberOfObjectives; ++m)
+    ExpectRelativelyClose(fa.objectives[m], fb.objectives[m], 1e-4, what + " objective " + std::to_string(m));
+  EXPECT_EQ(fa.feasible, fb.feasible);
+}
+} // namespace
+
+TEST(CudaEvaluationBackend, WholeSolutionsAgreeWithTheCpu)
+{
+  MOREA_REQUIRE_CUDA_DEVICE();
+  for (double rate : { 0.25, 2.0 })
+  {
+    OptimiserTestProblem problem;
+    problem.data.samplingRate = rate;
+    GomeaOptions options = problem.Options(3);
+    options.populationSize = 6;
+    auto population = problem.InitialPopulation(options);
+    // A folded solution too: a point pushed through its neighbours.
+    DualMesh folded = population.back();
+    folded.target[40][0] += 9.0;
+    population.push_back(folded);
+    auto cpu = CreateCpuEvaluationBackend(*problem.evaluator, 2);
+    auto cuda = CreateCudaEvaluationBackend(*problem.evaluator, 2);
+    EXPECT_EQ(cuda->Name(), "cuda");
+    std::vector<const DualMesh *>                solutions;
+    std::vector<std::vector<TetrahedronValues>> a(population.size()), b(population.size());
+    std::vector<std::vector<TetrahedronValues> *> pa, pb;
+    for (std::size_t i = 0; i < population.size(); ++i)
+    {
+      solutions.push_back(&population[i]);
+      pa.push_back(&a[i]);
+      pb.push_back(&b[i]);
+    }
+    cpu->EvaluateSolutions(solutions, pa);
+    cuda->EvaluateSolutions(solutions, pb);
+    for (std::size_t i = 0; i < population.size(); ++i)
+      ExpectSameTotals(a[i], b[i], "rate " + std::to_string(rate) + " solution " + std::to_string(i));
+    double folds = 0.0;
+    for (const auto & v : b.back())
+      folds += v.folded;
+    EXPECT_GT(folds, 0.0) << "the pushed point should fold the last solution";
+  }
+}
+
+TEST(CudaEvaluationBackend, PartialCandidatesAgreeWithTheCpu)
+{
+  MOREA_REQUIRE_CUDA_DEVICE();
+  OptimiserTestProblem problem;
+  GomeaOptions         options = problem.Options(4);
+  options.populationSize = 4;
+  const auto population = problem.InitialPopulation(options);
+  // One parallel group's elements for every solution, the points moved at random.
+  const auto &                   group = problem.parallel.groups.front();
+  RandomGenerator                random(11);
+  std::vector<std::vector<Vec3>> moved;
+  std::vector<PartialCandidate>  candidates;
+  moved.reserve(2 * group.size() * population.size());
+  for (const DualMesh & parent : population)
+    for (std::uint32_t e : group)
+    {
+      const FosElement & element = problem.parallel.elements[e];
+      std::vector<Vec3>  source, target;
+      for (std::uint32_t p : element.points)
+      {
+        Vec3 s = parent.source[p], t = parent.target[p];
+        for (int a = 0; a < 3; ++a)
+        {
+          s[a] += random.Normal() * 1.5;
+          t[a] += random.Normal() * 1.5;
+        }
+        source.push_back(s);
+        target.push_back(t);
+      }
+      moved.push_back(std::move(source));
+      moved.push_back(std::move(target));
+      PartialCandidate c;
+      c.parent = &parent;
+      c.element = &element;
+      c.source = moved[moved.size() - 2].data();
+      c.target = moved.back().data();
+      candidates.push_back(c);
+    }
+  std::vector<std::vector<TetrahedronValues>> a(candidates.size()), b(candidates.size());
+  auto                                        withValues = [&](std::vector<std::vector<TetrahedronValues>> & out) {
+    std::vector<PartialCandidate> batch = candidates;
+    for (std::size_t i = 0; i < batch.size(); ++i)
+    {
+      out[i].resize(batch[i].element->dependentTetrahedra.size());
+      batch[i].values = out[i].data();
+    }
+    return batch;
+  };
+  CreateCpuEvaluationBackend(*problem.evaluator, 2)->EvaluatePartials(withValues(a));
+  CreateCudaEvaluationBackend(*problem.evaluator, 2)->EvaluatePartials(withValues(b));
+  for (std::size_t i = 0; i < candidates.size(); ++i)
+    ExpectSameTotals(a[i], b[i], "candidate " + std::to_string(i));
+}
+
+TEST(CudaEvaluationBackend, VolumeBoundFoldsAgreeWithTheCpu)
+{
+  MOREA_REQUIRE_CUDA_DEVICE();
+  OptimiserTestProblem problem;
+  const FoldConstraint tight(problem.topology, problem.base.points, 0.9);
+  const TetrahedronEvaluator evaluator(problem.topology, tight, problem.elasticity, problem.data);
+  GomeaOptions               options = problem.Options(8);
+  options.populationSize = 5;
+  const auto population = problem.InitialPopulation(options);
+  std::vector<const DualMesh *>                solutions;
+  std::vector<std::vector<TetrahedronValues>> a(population.size()), b(population.size());
+  std::vector<std::vector<TetrahedronValues> *> pa, pb;
+  for (std::size_t i = 0; i < population.size(); ++i)
+  {
+    solutions.push_back(&population[i]);
+    pa.push_back(&a[i]);
+    pb.push_back(&b[i]);
+  }
+  CreateCpuEvaluationBackend(evaluator, 2)->EvaluateSolutions(solutions, pa);
+  CreateCudaEvaluationBackend(evaluator, 2)->EvaluateSolutions(solutions, pb);
+  double folds = 0.0;
+  for (std::size_t i = 0; i < population.size(); ++i)
+  {
+    ExpectSameTotals(a[i], b[i], "solution " + std::to_string(i));
+    for (const auto & v : a[i])
+      folds += v.folded;
+  }
+  EXPECT_GT(folds, 0.0) << "a fraction of 0.9 should flag some of the random deformations";
+}
+
+TEST(CudaEvaluationBackend, SeededRunsReachFrontsOfTheSameQuality)
+{
+  MOREA_REQUIRE_CUDA_DEVICE();
+  OptimiserTestProblem problem;
+  GomeaOptions         options = problem.Options(13, 16);
+  options.steeringEnabled = false; // hypervolume against the initial reference stays informative
+  auto run = [&](EvaluationBackend & backend) {
+    MoRvGomea optimiser(problem.base, problem.topology, problem.parallel, *problem.constraint, backend, options);
+    optimiser.Initialize(problem.InitialPopulation(options));
+    optimiser.Run();
+    // The stored objectives of the CUDA run are those the CPU computes.
+    auto cpu = CreateCpuEvaluationBackend(*problem.evaluator, 2);
+    for (const auto & entry : optimiser.Archive().Entries())
+    {
+      std::vector<TetrahedronValues> values;
+      cpu->EvaluateSolutions({ &entry.solution }, { &values });
+      ObjectiveTotals totals;
+      for (const auto & v : values)
+        totals.Add(v);
+      const Fitness f = totals.ToFitness(values.size());
+      for (std::size_t m = 0; m < NumberOfObjectives; ++m)
+        ExpectRelativelyClose(f.objectives[m], entry.fitness.objectives[m], 1e-4, backend.Name() + " archive");
+    }
+    return optimiser.History().back();
+  };
+  auto                   cpu = CreateCpuEvaluationBackend(*problem.evaluator, 2);
+  auto                   cuda = CreateCudaEvaluationBackend(*problem.evaluator, 2);
+  const GenerationRecord a = run(*cpu);
+  const GenerationRecord b = run(*cuda);
+  ASSERT_GT(a.hypervolume, 0.0);
+  EXPECT_NEAR(b.hypervolume, a.hypervolume, 0.05 * a.hypervolume);
+  EXPECT_NEAR(b.bestGuidance, a.bestGuidance, 0.25 * a.bestGuidance);
+}
+
+TEST(EvaluationBackendSelection, NamesAndDeviceAbsence)
+{
+  EXPECT_EQ(ParseBackendChoice("cpu"), BackendChoice::Cpu);
+  EXPECT_EQ(ParseBackendChoice("cuda"), BackendChoice::Cuda);
+  EXPECT_EQ(ParseBackendChoice("auto"), BackendChoice::Auto);
+  EXPECT_THROW(ParseBackendChoice("gpu"), Error);
+  OptimiserTestProblem problem;
+  EXPECT_EQ(CreateEvaluationBackend(BackendChoice::Cpu, *problem.evaluator, 1)->Name(), "cpu");
+  const std::string reason = CudaUnavailableReason();
+  auto              automatic = CreateEvaluationBackend(BackendChoice::Auto, *problem.evaluator, 1);
+  EXPECT_EQ(automatic->Name(), reason.empty() ? "cuda" : "cpu");
+  if (!reason.empty())
+  {
+    // No device (or no CUDA in the build): a clear error, not a crash.
+    try
+    {
+      CreateEvaluationBackend(BackendChoice::Cuda, *problem.evaluator, 1);
+      ADD_FAILURE() << "expected an error";
+    }
+    catch (const Error & e)
+    {
+      EXPECT_NE(std::string(e.what()).find("CUDA backend"), std::string::npos) << e.what();
+    }
+  }
+}
