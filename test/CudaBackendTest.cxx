@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <iostream>
 
 using namespace morea;
 using morea_test::OptimiserTestProblem;
@@ -22,16 +23,18 @@ namespace
   if (!CudaUnavailableReason().empty())                                                                                \
   GTEST_SKIP() << CudaUnavailableReason()
 
+/** |cpu - cuda| <= tolerance * max(|cpu|, floor): the floor keeps near-zero
+ *  sums (two almost equal intensities squared) from magnifying float rounding. */
 void
-ExpectRelativelyClose(double cpu, double cuda, double tolerance, const std::string & what)
+ExpectRelativelyClose(double cpu, double cuda, double tolerance, const std::string & what, double floor = 1e-12)
 {
-  EXPECT_LE(std::abs(cpu - cuda), tolerance * std::max(std::abs(cpu), 1e-12)) << what << ": cpu " << cpu << " cuda "
+  EXPECT_LE(std::abs(cpu - cuda), tolerance * std::max(std::abs(cpu), floor)) << what << ": cpu " << cpu << " cuda "
                                                                                << cuda;
 }
 
 void
 ExpectSameTotals(const std::vector<TetrahedronValues> & cpu, const std::vector<TetrahedronValues> & cuda,
-                 const std::string & what)
+                 const std::string & what, double floor = 1e-12)
 {
   ASSERT_EQ(cpu.size(), cuda.size());
   ObjectiveTotals a, b;
@@ -48,7 +51,7 @@ ExpectSameTotals(const std::vector<TetrahedronValues> & cpu, const std::vector<T
   }
   const Fitness fa = a.ToFitness(cpu.size()), fb = b.ToFitness(cuda.size());
   for (std::size_t m = 0; m < NumberOfObjectives; ++m)
-    ExpectRelativelyClose(fa.objectives[m], fb.objectives[m], 1e-4, what + " objective " + std::to_string(m));
+    ExpectRelativelyClose(fa.objectives[m], fb.objectives[m], 1e-4, what + " objective " + std::to_string(m), floor);
   EXPECT_EQ(fa.feasible, fb.feasible);
 }
 } // namespace
@@ -141,7 +144,7 @@ TEST(CudaEvaluationBackend, PartialCandidatesAgreeWithTheCpu)
   CreateCpuEvaluationBackend(*problem.evaluator, 2)->EvaluatePartials(withValues(a));
   CreateCudaEvaluationBackend(*problem.evaluator, 2)->EvaluatePartials(withValues(b));
   for (std::size_t i = 0; i < candidates.size(); ++i)
-    ExpectSameTotals(a[i], b[i], "candidate " + std::to_string(i));
+    ExpectSameTotals(a[i], b[i], "candidate " + std::to_string(i), 1e-6); // a few tetrahedra: sums can be ~0
 }
 
 TEST(CudaEvaluationBackend, VolumeBoundFoldsAgreeWithTheCpu)
@@ -206,6 +209,39 @@ TEST(CudaEvaluationBackend, SeededRunsReachFrontsOfTheSameQuality)
   ASSERT_GT(a.hypervolume, 0.0);
   EXPECT_NEAR(b.hypervolume, a.hypervolume, 0.05 * a.hypervolume);
   EXPECT_NEAR(b.bestGuidance, a.bestGuidance, 0.25 * a.bestGuidance);
+}
+
+TEST(CudaEvaluationBackend, TextureInterpolationStaysCloseToTheCpu)
+{
+  MOREA_REQUIRE_CUDA_DEVICE();
+  OptimiserTestProblem problem;
+  problem.data.samplingRate = 2.0;
+  GomeaOptions options = problem.Options(9);
+  options.populationSize = 4;
+  const auto population = problem.InitialPopulation(options);
+  auto       cpu = CreateCpuEvaluationBackend(*problem.evaluator, 2);
+  auto       texture = CreateCudaEvaluationBackend(*problem.evaluator, 2, CudaInterpolation::Texture);
+  EXPECT_EQ(texture->Name(), "cuda-texture");
+  for (const DualMesh & s : population)
+  {
+    std::vector<TetrahedronValues> a, b;
+    cpu->EvaluateSolutions({ &s }, { &a });
+    texture->EvaluateSolutions({ &s }, { &b });
+    ObjectiveTotals ta, tb;
+    for (std::size_t t = 0; t < a.size(); ++t)
+    {
+      EXPECT_EQ(a[t].samples, b[t].samples);
+      ta.Add(a[t]);
+      tb.Add(b[t]);
+    }
+    const Fitness fa = ta.ToFitness(a.size()), fb = tb.ToFitness(b.size());
+    for (std::size_t m = 0; m < NumberOfObjectives; ++m)
+    {
+      const double relative = std::abs(fa.objectives[m] - fb.objectives[m]) / std::max(std::abs(fa.objectives[m]), 1e-12);
+      std::cout << "texture interpolation, objective " << m << ": relative difference " << relative << "\n";
+      EXPECT_LT(relative, 1e-2);
+    }
+  }
 }
 
 TEST(EvaluationBackendSelection, NamesAndDeviceAbsence)

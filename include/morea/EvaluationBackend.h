@@ -71,11 +71,19 @@ protected:
 std::unique_ptr<EvaluationBackend>
 CreateCpuEvaluationBackend(const TetrahedronEvaluator & evaluator, std::size_t threads = 0);
 
+/** How the CUDA backend interpolates images with at most 4 channels. */
+enum class CudaInterpolation
+{
+  Exact,  ///< software trilinear: agrees with the CPU backend to rounding (the default)
+  Texture ///< the texture units' filtering (9-bit weights): faster, agrees less closely
+};
+
 /** The CUDA backend on device 0 (`threads` host threads pack and unpack the
  *  batches). Throws morea::Error when the build has no CUDA or no device is
  *  present, and names out-of-memory as such. */
 std::unique_ptr<EvaluationBackend>
-CreateCudaEvaluationBackend(const TetrahedronEvaluator & evaluator, std::size_t threads = 0);
+CreateCudaEvaluationBackend(const TetrahedronEvaluator & evaluator, std::size_t threads = 0,
+                            CudaInterpolation interpolation = CudaInterpolation::Exact);
 
 enum class BackendChoice
 {

@@ -38,13 +38,15 @@ Since(Clock::time_point start)
 
 /** One backend's run: `generations` generations from the seeded start. */
 nlohmann::json
-TimeBackend(BackendChoice choice, const itk::morea::MeshModel & model, const TetrahedronEvaluator & evaluator,
+TimeBackend(const std::string & name, const itk::morea::MeshModel & model, const TetrahedronEvaluator & evaluator,
             const GomeaOptions & gomea, const InitialPopulationOptions & initial, std::size_t generations,
             std::size_t threads)
 {
   const std::size_t memoryBefore = CudaMemoryInUse();
   std::size_t       memoryPeak = memoryBefore;
-  auto              backend = CreateEvaluationBackend(choice, evaluator, threads);
+  auto              backend = name == "cuda-texture"
+                                ? CreateCudaEvaluationBackend(evaluator, threads, CudaInterpolation::Texture)
+                                : CreateEvaluationBackend(ParseBackendChoice(name), evaluator, threads);
   std::cout << "  backend " << backend->Name() << ": initial population of " << gomea.populationSize << "\n"
             << std::flush;
   auto                 start = Clock::now();
@@ -131,7 +133,7 @@ AddBenchmarkCommand(CLI::App & app)
   options->problem.AddTo(*cmd);
   options->parameters.AddTo(*cmd);
   cmd->add_option("-o,--output", options->output, "JSON file for the results")->required();
-  cmd->add_option("--backends", options->backends, "comma-separated: cuda, cpu")->capture_default_str();
+  cmd->add_option("--backends", options->backends, "comma-separated: cuda, cuda-texture, cpu")->capture_default_str();
   cmd->add_option("--generations", options->generations, "generations of the CUDA run (0: ea_num_generations)")
     ->capture_default_str();
   cmd->add_option("--cpu-generations", options->cpuGenerations, "generations of the CPU run (the same first ones)")
@@ -182,11 +184,10 @@ AddBenchmarkCommand(CLI::App & app)
     std::stringstream list(options->backends);
     for (std::string name; std::getline(list, name, ',');)
     {
-      const BackendChoice choice = ParseBackendChoice(name);
-      const std::size_t   generations =
-        choice == BackendChoice::Cpu ? options->cpuGenerations : (options->generations ? options->generations : gomea.generations);
+      const std::size_t generations =
+        name == "cpu" ? options->cpuGenerations : (options->generations ? options->generations : gomea.generations);
       std::cout << "timing " << name << " for " << generations << " generations\n";
-      report["runs"][name] = TimeBackend(choice, model, evaluator, gomea, initial, generations, options->threads);
+      report["runs"][name] = TimeBackend(name, model, evaluator, gomea, initial, generations, options->threads);
     }
     if (report.contains("runs") && report["runs"].contains("cuda") && report["runs"].contains("cpu"))
     {

@@ -15,6 +15,7 @@
 #include "morea/ThreadPool.h"
 
 #include <algorithm>
+#include <vector>
 #include <chrono>
 
 namespace morea
@@ -26,7 +27,7 @@ using cuda::Check;
 class CudaEvaluationBackend final : public EvaluationBackend
 {
 public:
-  CudaEvaluationBackend(const TetrahedronEvaluator & evaluator, std::size_t threads)
+  CudaEvaluationBackend(const TetrahedronEvaluator & evaluator, std::size_t threads, CudaInterpolation interpolation)
     : m_Evaluator(evaluator)
     , m_Pool(threads)
   {
@@ -40,8 +41,6 @@ public:
     cuda::UploadSobolDirections(SobolDirectionNumbers());
 
     const ObjectiveData & data = evaluator.Data();
-    m_Constants.moving = Upload(data.moving, m_Moving);
-    m_Constants.fixed = Upload(data.fixed, m_Fixed);
     m_Constants.structures = static_cast<int>(data.NumberOfGuidanceStructures());
     m_Constants.guidanceWeights = Upload(data.guidanceWeights, m_GuidanceWeights);
     m_Constants.guidanceRadius = data.guidanceRadius;
@@ -50,13 +49,27 @@ public:
     m_Constants.elasticity = evaluator.Elasticity().empty() ? nullptr : Upload(evaluator.Elasticity(), m_Elasticity);
     m_Constants.referenceVolumes = Upload(evaluator.Constraint().ReferenceVolumes(), m_ReferenceVolumes);
     m_Constants.volumeFraction = evaluator.Constraint().VolumeFraction();
+    if (data.moving.channels <= 4)
+    {
+      // The fast kernels read 4 channels per voxel at once.
+      m_Constants.packed = true;
+      m_Constants.interpolation =
+        interpolation == CudaInterpolation::Texture ? cuda::Interpolation::Texture : cuda::Interpolation::Exact;
+      m_Constants.packedMoving = UploadPacked(data.moving, m_PackedMoving, m_MovingTexture, interpolation);
+      m_Constants.packedFixed = UploadPacked(data.fixed, m_PackedFixed, m_FixedTexture, interpolation);
+    }
+    else
+    {
+      m_Constants.moving = Upload(data.moving, m_Moving);
+      m_Constants.fixed = Upload(data.fixed, m_Fixed);
+    }
     Check(cudaStreamSynchronize(m_Stream->Get()), "uploading the images");
   }
 
   std::string
   Name() const override
   {
-    return "cuda";
+    return m_Constants.packed && m_Constants.interpolation == cuda::Interpolation::Texture ? "cuda-texture" : "cuda";
   }
 
   void
@@ -138,8 +151,41 @@ private:
       view.size[a] = static_cast<int>(volume.size[a]);
       view.origin[a] = volume.origin[a];
       view.spacing[a] = volume.spacing[a];
+      view.inverseSpacing[a] = 1.0 / volume.spacing[a];
     }
     view.channels = static_cast<int>(volume.channels);
+    return view;
+  }
+
+  cuda::PackedVolumeView
+  UploadPacked(const ChannelVolume & volume, cuda::DeviceArray<float> & device,
+               std::unique_ptr<cuda::Texture3D> & texture, CudaInterpolation interpolation)
+  {
+    const std::size_t  voxels = volume.size[0] * volume.size[1] * volume.size[2];
+    std::vector<float> packed(4 * voxels, 0.0f);
+    for (std::size_t v = 0; v < voxels; ++v)
+      for (std::size_t c = 0; c < volume.channels; ++c)
+        packed[4 * v + c] = volume.data[volume.channels * v + c];
+    cuda::PackedVolumeView view;
+    for (int a = 0; a < 3; ++a)
+    {
+      view.size[a] = static_cast<int>(volume.size[a]);
+      view.origin[a] = volume.origin[a];
+      view.spacing[a] = volume.spacing[a];
+      view.inverseSpacing[a] = 1.0 / volume.spacing[a];
+    }
+    if (interpolation == CudaInterpolation::Texture)
+    {
+      texture = std::make_unique<cuda::Texture3D>(packed.data(), view.size);
+      view.texture = static_cast<unsigned long long>(texture->Get());
+    }
+    else
+    {
+      device.Reserve(packed.size());
+      Check(cudaMemcpy(device.Data(), packed.data(), packed.size() * sizeof(float), cudaMemcpyHostToDevice),
+            "uploading an image");
+      view.data = device.Data();
+    }
     return view;
   }
 
@@ -222,7 +268,8 @@ private:
   std::unique_ptr<cuda::Stream> m_Stream;
   std::unique_ptr<cuda::Event>  m_KernelStart, m_KernelEnd;
   cuda::EvaluationConstants     m_Constants;
-  cuda::DeviceArray<float>      m_Moving, m_Fixed;
+  cuda::DeviceArray<float>      m_Moving, m_Fixed, m_PackedMoving, m_PackedFixed;
+  std::unique_ptr<cuda::Texture3D> m_MovingTexture, m_FixedTexture;
   cuda::DeviceArray<double>     m_GuidanceWeights, m_Elasticity, m_ReferenceVolumes;
   cuda::DeviceArray<double>     m_Corners, m_ItemValues, m_DirectionValues;
   cuda::DeviceArray<std::uint32_t> m_Tetrahedra;
@@ -232,8 +279,9 @@ private:
 } // namespace
 
 std::unique_ptr<EvaluationBackend>
-CreateCudaEvaluationBackend(const TetrahedronEvaluator & evaluator, std::size_t threads)
+CreateCudaEvaluationBackend(const TetrahedronEvaluator & evaluator, std::size_t threads,
+                            CudaInterpolation interpolation)
 {
-  return std::make_unique<CudaEvaluationBackend>(evaluator, threads);
+  return std::make_unique<CudaEvaluationBackend>(evaluator, threads, interpolation);
 }
 } // namespace morea

@@ -148,6 +148,53 @@ public:
 private:
   cudaStream_t m_Stream{ nullptr };
 };
+/** A 3D float4 texture with trilinear filtering (clamped, unnormalised
+ *  coordinates), owning its array. */
+class Texture3D
+{
+public:
+  Texture3D(const float * float4Voxels, const int size[3])
+  {
+    const cudaChannelFormatDesc format = cudaCreateChannelDesc<float4>();
+    const cudaExtent            extent = make_cudaExtent(size[0], size[1], size[2]);
+    Check(cudaMalloc3DArray(&m_Array, &format, extent), "allocating a texture array");
+    cudaMemcpy3DParms copy{};
+    copy.srcPtr = make_cudaPitchedPtr(const_cast<float *>(float4Voxels), size[0] * 4 * sizeof(float), size[0], size[1]);
+    copy.dstArray = m_Array;
+    copy.extent = extent;
+    copy.kind = cudaMemcpyHostToDevice;
+    Check(cudaMemcpy3D(&copy), "filling a texture array");
+    cudaResourceDesc resource{};
+    resource.resType = cudaResourceTypeArray;
+    resource.res.array.array = m_Array;
+    cudaTextureDesc description{};
+    description.addressMode[0] = description.addressMode[1] = description.addressMode[2] = cudaAddressModeClamp;
+    description.filterMode = cudaFilterModeLinear;
+    description.readMode = cudaReadModeElementType;
+    description.normalizedCoords = 0;
+    Check(cudaCreateTextureObject(&m_Texture, &resource, &description, nullptr), "creating a texture");
+  }
+  ~Texture3D()
+  {
+    if (m_Texture)
+      cudaDestroyTextureObject(m_Texture);
+    if (m_Array)
+      cudaFreeArray(m_Array);
+  }
+  Texture3D(const Texture3D &) = delete;
+  Texture3D &
+  operator=(const Texture3D &) = delete;
+  cudaTextureObject_t
+  Get() const
+  {
+    return m_Texture;
+  }
+
+private:
+  cudaArray_t         m_Array{ nullptr };
+  cudaTextureObject_t m_Texture{ 0 };
+};
+
 /** A CUDA event (timing only) owned for the lifetime of the object. */
 class Event
 {

@@ -36,7 +36,7 @@ MeasureTrilinearFetchRate()
 }
 
 std::unique_ptr<EvaluationBackend>
-CreateCudaEvaluationBackend(const TetrahedronEvaluator &, std::size_t)
+CreateCudaEvaluationBackend(const TetrahedronEvaluator &, std::size_t, CudaInterpolation)
 {
   throw Error("CUDA backend: " + CudaUnavailableReason());
 }

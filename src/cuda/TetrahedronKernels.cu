@@ -150,7 +150,7 @@ struct Trilinear
     double f[3];
     for (int a = 0; a < 3; ++a)
     {
-      double       x = (p[a] - image.origin[a]) / image.spacing[a];
+      double       x = (p[a] - image.origin[a]) * image.inverseSpacing[a];
       const double last = static_cast<double>(image.size[a] - 1);
       x = x < 0.0 ? 0.0 : (x > last ? last : x);
       double i = floor(x);
@@ -189,9 +189,104 @@ struct Trilinear
   Channel(int channel) const
   {
     double s = 0.0;
+#pragma unroll
     for (int k = 0; k < 8; ++k)
       s += w[k] * static_cast<double>(__ldg(v + o[k] + channel));
     return static_cast<float>(s);
+  }
+};
+
+/** Grid position of `p` (clamped like ChannelVolume::Sample): the first
+ *  corner's index and the fractions. */
+template <typename View>
+__device__ void
+GridPosition(const View & image, const double p[3], int base[3], double f[3])
+{
+  for (int a = 0; a < 3; ++a)
+  {
+    double       x = (p[a] - image.origin[a]) * image.inverseSpacing[a];
+    const double last = static_cast<double>(image.size[a] - 1);
+    x = x < 0.0 ? 0.0 : (x > last ? last : x);
+    double i = floor(x);
+    if (i >= last && image.size[a] > 1)
+      i = last - 1.0;
+    base[a] = static_cast<int>(i);
+    f[a] = image.size[a] > 1 ? x - i : 0.0;
+  }
+}
+
+__device__ float
+Component(const float4 & v, int c)
+{
+  return c == 0 ? v.x : (c == 1 ? v.y : (c == 2 ? v.z : v.w));
+}
+
+/** Up to 4 channels from one 16-byte load per corner, weights in single
+ *  precision: agrees with the CPU to rounding. */
+struct PackedExact
+{
+  float4 v;
+
+  __device__
+  PackedExact(const PackedVolumeView & image, const double p[3])
+  {
+    int    base[3];
+    double f[3];
+    GridPosition(image, p, base, f);
+    const int     sx = image.size[0] > 1 ? 1 : 0;
+    const int     sy = image.size[1] > 1 ? image.size[0] : 0;
+    const int     sz = image.size[2] > 1 ? image.size[0] * image.size[1] : 0;
+    const float4 * d = static_cast<const float4 *>(image.data) +
+                       (static_cast<std::size_t>(base[0]) +
+                        static_cast<std::size_t>(image.size[0]) *
+                          (static_cast<std::size_t>(base[1]) + static_cast<std::size_t>(image.size[1]) * base[2]));
+    const float fx = static_cast<float>(f[0]), fy = static_cast<float>(f[1]), fz = static_cast<float>(f[2]);
+    const float4 c000 = __ldg(d), c100 = __ldg(d + sx), c010 = __ldg(d + sy), c110 = __ldg(d + sx + sy);
+    const float4 c001 = __ldg(d + sz), c101 = __ldg(d + sx + sz), c011 = __ldg(d + sy + sz),
+                 c111 = __ldg(d + sx + sy + sz);
+    const float w[8] = { (1 - fx) * (1 - fy) * (1 - fz), fx * (1 - fy) * (1 - fz), (1 - fx) * fy * (1 - fz),
+                         fx * fy * (1 - fz),             (1 - fx) * (1 - fy) * fz, fx * (1 - fy) * fz,
+                         (1 - fx) * fy * fz,             fx * fy * fz };
+    const float4 c[8] = { c000, c100, c010, c110, c001, c101, c011, c111 };
+    v = make_float4(0.0f, 0.0f, 0.0f, 0.0f);
+#pragma unroll
+    for (int k = 0; k < 8; ++k)
+    {
+      v.x += w[k] * c[k].x;
+      v.y += w[k] * c[k].y;
+      v.z += w[k] * c[k].z;
+      v.w += w[k] * c[k].w;
+    }
+  }
+  __device__ float
+  Channel(int c) const
+  {
+    return Component(v, c);
+  }
+};
+
+/** Up to 4 channels from one filtered texture fetch. */
+struct PackedTexture
+{
+  float4 v;
+
+  __device__
+  PackedTexture(const PackedVolumeView & image, const double p[3])
+  {
+    float x[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      double       t = (p[a] - image.origin[a]) * image.inverseSpacing[a];
+      const double last = static_cast<double>(image.size[a] - 1);
+      t = t < 0.0 ? 0.0 : (t > last ? last : t);
+      x[a] = static_cast<float>(t) + 0.5f; // texel centres lie at +0.5
+    }
+    v = tex3D<float4>(static_cast<cudaTextureObject_t>(image.texture), x[0], x[1], x[2]);
+  }
+  __device__ float
+  Channel(int c) const
+  {
+    return Component(v, c);
   }
 };
 
@@ -203,8 +298,9 @@ WarpSum(double x)
   return x;
 }
 
-__global__ void
-EvaluateTetrahedraKernel(EvaluationConstants k, const double * __restrict__ corners,
+template <typename Sampler, typename View>
+__global__ void __launch_bounds__(256, 2)
+EvaluateTetrahedraKernel(EvaluationConstants k, View moving, View fixed, const double * __restrict__ corners,
                          const std::uint32_t * __restrict__ tetrahedra, std::size_t items, double * itemOut,
                          double * directionOut)
 {
@@ -214,18 +310,21 @@ EvaluateTetrahedraKernel(EvaluationConstants k, const double * __restrict__ corn
     return; // whole warps leave together: 2 * items warps exactly
   const std::size_t item = warp >> 1;
   const int         direction = static_cast<int>(warp & 1);
-  double            source[12], target[12];
+  // Direction 0 samples the source tetrahedron (moving image) and maps to
+  // the target (fixed image); direction 1 the other way round. The corners
+  // go to registers: selecting between two local arrays at run time would
+  // put them in (slow) local memory.
+  const double * c = corners + item * ItemCorners;
+  const int      fromOffset = direction == 0 ? 0 : 12;
+  double         from[12], to[12];
+#pragma unroll
   for (int i = 0; i < 12; ++i)
   {
-    source[i] = corners[item * ItemCorners + i];
-    target[i] = corners[item * ItemCorners + 12 + i];
+    from[i] = c[fromOffset + i];
+    to[i] = c[12 - fromOffset + i];
   }
-  // Direction 0 samples the source tetrahedron (moving image) and maps to
-  // the target (fixed image); direction 1 the other way round.
-  const double *     from = direction == 0 ? source : target;
-  const double *     to = direction == 0 ? target : source;
-  const VolumeView & fromImage = direction == 0 ? k.moving : k.fixed;
-  const VolumeView & toImage = direction == 0 ? k.fixed : k.moving;
+  const View fromImage = direction == 0 ? moving : fixed;
+  const View toImage = direction == 0 ? fixed : moving;
 
   const double volume = fabs(SignedVolume(from));
   double       count = round(__ddiv_rn(__dmul_rn(k.samplingRate, volume), k.voxelVolume));
@@ -234,31 +333,58 @@ EvaluateTetrahedraKernel(EvaluationConstants k, const double * __restrict__ corn
   SobolShifts(TetrahedronSeed(from), shift);
 
   const double r = k.guidanceRadius;
-  double       intensity = 0.0, guidance = 0.0;
-  for (std::uint32_t s = lane; s < n; s += 32)
+  const double inverseRadius = 1.0 / r;
+  // Sample s = 32 j + lane has Gray code gray(s) = 16 (2j ^ j) ^ gray(lane)
+  // (XOR is linear and the parts' bits do not overlap), so its Sobol state is
+  // this lane's fixed part XOR a part shared by the whole warp.
+  std::uint32_t laneState[4];
   {
-    const std::uint32_t gray = s ^ (s >> 1);
-    double              w[4], sum = 0.0;
+    const std::uint32_t gray = static_cast<std::uint32_t>(lane) ^ (static_cast<std::uint32_t>(lane) >> 1);
+#pragma unroll
     for (int d = 0; d < 4; ++d)
     {
-      std::uint32_t state = 0;
-      for (std::uint32_t bits = gray, b = 0; bits; bits >>= 1, ++b)
-        if (bits & 1u)
+      std::uint32_t state = shift[d];
+#pragma unroll
+      for (int b = 0; b < 5; ++b)
+        if ((gray >> b) & 1u)
           state ^= c_SobolDirections[d * 32 + b];
-      const double u = (static_cast<double>(state ^ shift[d]) + 0.5) / 4294967296.0;
-      sum += (w[d] = -log(u));
+      laneState[d] = state;
     }
-    double p[3] = { 0.0, 0.0, 0.0 }, q[3] = { 0.0, 0.0, 0.0 };
+  }
+  double intensity = 0.0, guidance = 0.0;
+  for (std::uint32_t j = 0; 32 * j < n; ++j)
+  {
+    std::uint32_t shared[4] = { 0, 0, 0, 0 };
+    for (std::uint32_t bits = (2 * j) ^ j, b = 4; bits; bits >>= 1, ++b) // warp-uniform loop
+      if (bits & 1u)
+#pragma unroll
+        for (int d = 0; d < 4; ++d)
+          shared[d] ^= c_SobolDirections[d * 32 + b];
+    if (32 * j + lane >= n)
+      break;
+    // Barycentric weights -log(u) in single precision: the samples' positions
+    // move by ~1e-7 of the tetrahedron's size, far below the agreement bound.
+    float w[4], sum = 0.0f;
+#pragma unroll
+    for (int d = 0; d < 4; ++d)
+    {
+      const float u = (static_cast<float>(laneState[d] ^ shared[d]) + 0.5f) * 2.3283064365386963e-10f;
+      sum += (w[d] = -logf(u));
+    }
+    const double inverseSum = 1.0 / static_cast<double>(sum);
+    double       p[3] = { 0.0, 0.0, 0.0 }, q[3] = { 0.0, 0.0, 0.0 };
+#pragma unroll
     for (int i = 0; i < 4; ++i)
     {
-      const double wi = w[i] / sum;
+      const double wi = static_cast<double>(w[i]) * inverseSum;
+#pragma unroll
       for (int a = 0; a < 3; ++a)
       {
         p[a] += wi * from[3 * i + a];
         q[a] += wi * to[3 * i + a];
       }
     }
-    const Trilinear at(fromImage, p), bt(toImage, q);
+    const Sampler   at(fromImage, p), bt(toImage, q);
     const float     a0 = at.Channel(0), b0 = bt.Channel(0);
     if (a0 > 0.0f && b0 > 0.0f)
     {
@@ -273,7 +399,7 @@ EvaluateTetrahedraKernel(EvaluationConstants k, const double * __restrict__ corn
       if (d < r)
       {
         const double e = d - static_cast<double>(bt.Channel(1 + g));
-        guidance += k.guidanceWeights[g] * (r - d) / r * e * e;
+        guidance += k.guidanceWeights[g] * (r - d) * inverseRadius * e * e;
       }
     }
   }
@@ -285,14 +411,14 @@ EvaluateTetrahedraKernel(EvaluationConstants k, const double * __restrict__ corn
   out[0] = intensity;
   out[1] = guidance;
   out[2] = static_cast<double>(n);
-  if (direction == 0)
+  if (direction == 0) // from = source, to = target
   {
     const std::uint32_t t = tetrahedra[item];
     double              folded = 0.0;
-    double              value = VolumeViolation(SignedVolume(source), k.referenceVolumes[t], k.volumeFraction, folded);
-    value += VolumeViolation(SignedVolume(target), k.referenceVolumes[t], k.volumeFraction, folded);
+    double              value = VolumeViolation(SignedVolume(from), k.referenceVolumes[t], k.volumeFraction, folded);
+    value += VolumeViolation(SignedVolume(to), k.referenceVolumes[t], k.volumeFraction, folded);
     double * o = itemOut + item * ItemValues;
-    o[0] = TetrahedronMagnitude(source, target, k.elasticity ? k.elasticity[t] : 1.0);
+    o[0] = TetrahedronMagnitude(from, to, k.elasticity ? k.elasticity[t] : 1.0);
     o[1] = value;
     o[2] = folded;
   }
@@ -315,9 +441,18 @@ LaunchEvaluateTetrahedra(const EvaluationConstants & constants, const double * c
     return;
   const std::size_t warps = 2 * items;
   const std::size_t blocks = (warps + WarpsPerBlock - 1) / WarpsPerBlock;
-  EvaluateTetrahedraKernel<<<static_cast<unsigned>(blocks), WarpsPerBlock * 32, 0,
-                             static_cast<cudaStream_t>(stream)>>>(constants, corners, tetrahedra, items, itemOut,
-                                                                  directionOut);
+  const unsigned     grid = static_cast<unsigned>(blocks);
+  const cudaStream_t s = static_cast<cudaStream_t>(stream);
+  const auto &       k = constants;
+  if (!k.packed)
+    EvaluateTetrahedraKernel<Trilinear><<<grid, WarpsPerBlock * 32, 0, s>>>(k, k.moving, k.fixed, corners, tetrahedra,
+                                                                           items, itemOut, directionOut);
+  else if (k.interpolation == Interpolation::Exact)
+    EvaluateTetrahedraKernel<PackedExact><<<grid, WarpsPerBlock * 32, 0, s>>>(
+      k, k.packedMoving, k.packedFixed, corners, tetrahedra, items, itemOut, directionOut);
+  else
+    EvaluateTetrahedraKernel<PackedTexture><<<grid, WarpsPerBlock * 32, 0, s>>>(
+      k, k.packedMoving, k.packedFixed, corners, tetrahedra, items, itemOut, directionOut);
   Check(cudaGetLastError(), "launching the tetrahedron kernel");
 }
 } // namespace morea::cuda

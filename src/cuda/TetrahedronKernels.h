@@ -15,7 +15,27 @@ struct VolumeView
   int           size[3]{ 0, 0, 0 };
   double        origin[3]{ 0.0, 0.0, 0.0 };
   double        spacing[3]{ 1.0, 1.0, 1.0 };
+  double        inverseSpacing[3]{ 1.0, 1.0, 1.0 };
   int           channels{ 0 };
+};
+
+/** How the kernels interpolate the images. */
+enum class Interpolation
+{
+  Exact,   ///< trilinear in software from 16-byte loads, weights as on the CPU (agrees to rounding)
+  Texture  ///< the texture units' trilinear filtering (9-bit weights: faster, not bit-comparable)
+};
+
+/** The same volume with its channels padded to 4 (float4 per voxel), in
+ *  global memory for Exact and as a texture object for Texture. */
+struct PackedVolumeView
+{
+  const void *       data{ nullptr };   ///< float4 per voxel
+  unsigned long long texture{ 0 };      ///< cudaTextureObject_t
+  int                size[3]{ 0, 0, 0 };
+  double             origin[3]{ 0.0, 0.0, 0.0 };
+  double             spacing[3]{ 1.0, 1.0, 1.0 };
+  double             inverseSpacing[3]{ 1.0, 1.0, 1.0 };
 };
 
 /** Everything a tetrahedron's evaluation reads besides its corners. */
@@ -31,6 +51,10 @@ struct EvaluationConstants
   const double *  elasticity{ nullptr };       ///< per tetrahedron, or null (all 1)
   const double *  referenceVolumes{ nullptr }; ///< signed base volume per tetrahedron
   double          volumeFraction{ 0.0 };
+  /** Set when the images have at most 4 channels: the fast kernels use these. */
+  bool             packed{ false };
+  Interpolation    interpolation{ Interpolation::Exact };
+  PackedVolumeView packedMoving, packedFixed;
 };
 
 /** Per work item: magnitude, fold value, folded count. */
