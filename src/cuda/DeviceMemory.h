@@ -10,7 +10,6 @@
 
 #include <cstddef>
 #include <string>
-#include <utility>
 
 namespace morea::cuda
 {
@@ -26,69 +25,48 @@ Check(cudaError_t status, const char * what)
   throw Error(std::string("CUDA backend: ") + what + ": " + cudaGetErrorString(status));
 }
 
-/** Device memory for `count` elements of T; grows on demand, never shrinks. */
-template <typename T>
-class DeviceArray
+/** Where a GrowingArray lives: device memory or page-locked host memory
+ *  (fast asynchronous copies). */
+struct DeviceAllocation
 {
-public:
-  DeviceArray() = default;
-  explicit DeviceArray(std::size_t count) { Reserve(count); }
-  ~DeviceArray() { Release(); }
-  DeviceArray(const DeviceArray &) = delete;
-  DeviceArray &
-  operator=(const DeviceArray &) = delete;
-  DeviceArray(DeviceArray && o) noexcept
-    : m_Data(std::exchange(o.m_Data, nullptr))
-    , m_Capacity(std::exchange(o.m_Capacity, 0))
-  {}
-
-  /** At least `count` elements; the old contents are lost when it grows. */
-  void
-  Reserve(std::size_t count)
+  static constexpr const char * what = "of device memory";
+  static cudaError_t
+  Allocate(void ** p, std::size_t bytes)
   {
-    if (count <= m_Capacity)
-      return;
-    Release();
-    const std::size_t bytes = count * sizeof(T);
-    void *            p = nullptr;
-    Check(cudaMalloc(&p, bytes), (std::to_string(bytes >> 20) + " MiB of device memory").c_str());
-    m_Data = static_cast<T *>(p);
-    m_Capacity = count;
+    return cudaMalloc(p, bytes);
   }
-  T *
-  Data() const
+  static void
+  Free(void * p) noexcept
   {
-    return m_Data;
+    cudaFree(p); // errors at release cannot be reported usefully
   }
-  std::size_t
-  Capacity() const
+};
+struct PinnedAllocation
+{
+  static constexpr const char * what = "of pinned host memory";
+  static cudaError_t
+  Allocate(void ** p, std::size_t bytes)
   {
-    return m_Capacity;
+    return cudaMallocHost(p, bytes);
   }
-
-private:
-  void
-  Release() noexcept
+  static void
+  Free(void * p) noexcept
   {
-    if (m_Data)
-      cudaFree(m_Data); // errors at release cannot be reported usefully
-    m_Data = nullptr;
-    m_Capacity = 0;
+    cudaFreeHost(p);
   }
-  T *         m_Data{ nullptr };
-  std::size_t m_Capacity{ 0 };
 };
 
-/** Page-locked host memory (fast asynchronous copies); grows on demand. */
-template <typename T>
-class PinnedArray
+/** `count` elements of T; grows on demand (losing the contents), never shrinks. */
+template <typename T, typename Allocation>
+class GrowingArray
 {
 public:
-  PinnedArray() = default;
-  ~PinnedArray() { Release(); }
-  PinnedArray(const PinnedArray &) = delete;
-  PinnedArray &
-  operator=(const PinnedArray &) = delete;
+  GrowingArray() = default;
+  explicit GrowingArray(std::size_t count) { Reserve(count); }
+  ~GrowingArray() { Release(); }
+  GrowingArray(const GrowingArray &) = delete;
+  GrowingArray &
+  operator=(const GrowingArray &) = delete;
 
   void
   Reserve(std::size_t count)
@@ -98,7 +76,7 @@ public:
     Release();
     const std::size_t bytes = count * sizeof(T);
     void *            p = nullptr;
-    Check(cudaMallocHost(&p, bytes), (std::to_string(bytes >> 20) + " MiB of pinned host memory").c_str());
+    Check(Allocation::Allocate(&p, bytes), (std::to_string(bytes >> 20) + " MiB " + Allocation::what).c_str());
     m_Data = static_cast<T *>(p);
     m_Capacity = count;
   }
@@ -118,13 +96,18 @@ private:
   Release() noexcept
   {
     if (m_Data)
-      cudaFreeHost(m_Data);
+      Allocation::Free(m_Data);
     m_Data = nullptr;
     m_Capacity = 0;
   }
   T *         m_Data{ nullptr };
   std::size_t m_Capacity{ 0 };
 };
+
+template <typename T>
+using DeviceArray = GrowingArray<T, DeviceAllocation>;
+template <typename T>
+using PinnedArray = GrowingArray<T, PinnedAllocation>;
 
 /** A CUDA stream owned for the lifetime of the object. */
 class Stream
