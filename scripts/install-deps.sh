@@ -15,6 +15,8 @@ packages=(
   libgtest-dev libgmock-dev
   libpng-dev zlib1g-dev
   xz-utils                 # tests unpack the DICOM test archive
+  elastix                  # comparison study (study/): elastix 5.0.1 and transformix
+  python3-venv python3-pip # comparison study: Python packages in a venv
 )
 
 SUDO=""
@@ -27,5 +29,20 @@ done
 if [ ${#missing[@]} -gt 0 ]; then
   $SUDO apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+# Comparison study (study/): Python packages from PyPI in a venv under the build
+# folder (MOREA_STUDY_VENV overrides); study/CMakeLists.txt finds it there.
+# A failed download leaves the study's CTest tests skipping, not failing.
+ROOT="$(cd "$(dirname "$0")/.." && pwd)"
+VENV="${MOREA_STUDY_VENV:-$ROOT/build/study-venv}"
+STUDY_PACKAGES=(numpy scipy matplotlib SimpleITK antspyx pymia pytest)
+if [ ! -x "$VENV/bin/python" ]; then
+  mkdir -p "$(dirname "$VENV")"
+  /usr/bin/python3 -m venv "$VENV" || echo "warning: could not create $VENV" >&2
+fi
+if [ -x "$VENV/bin/python" ] && ! "$VENV/bin/python" -c "import numpy, scipy, matplotlib, SimpleITK, ants, pymia, pytest" 2>/dev/null; then
+  "$VENV/bin/python" -m pip install -q --disable-pip-version-check "${STUDY_PACKAGES[@]}" \
+    || echo "warning: study packages not installed; the study's tests will be skipped" >&2
 fi
 echo "dependencies: ok"

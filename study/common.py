@@ -200,7 +200,7 @@ def sample_field(field: np.ndarray, field_ref, points: np.ndarray) -> np.ndarray
     return out
 
 
-def invert_field(field: np.ndarray, field_ref, target_ref, iterations: int = 60,
+def invert_field(field: np.ndarray, field_ref, target_ref, iterations: int = 30,
                  tolerance: float = 1e-3) -> tuple[np.ndarray, dict]:
     """Numerical inverse of x -> x + u(x) on `target_ref`'s grid by fixed-point
     iteration v(y) = -u(y + v(y)). Returns (v, {'iterations', 'max_residual_mm'})."""

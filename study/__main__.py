@@ -1,0 +1,5 @@
+import sys
+
+from .run_study import main
+
+sys.exit(main())

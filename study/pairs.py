@@ -1,0 +1,89 @@
+"""The registration problems of the study: raw inputs (as `morea` options),
+the MOREA parameter file (whose preprocessing keys define the problem every
+method is scored on) and the most-deforming structure with the scores that
+decide the competitors' best configuration and the statistical tests."""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from . import common
+
+DEFAULT_DATA = common.REPO_ROOT.parent / "shared" / "data"
+
+
+@dataclass
+class Criterion:
+    column: str          # column of results.csv
+    higher_is_better: bool
+    label: str
+
+
+@dataclass
+class Pair:
+    name: str
+    description: str
+    morea_parameters: Path
+    primary_structure: str
+    criteria: list[Criterion]             # the first decides the best configuration
+    raw_args: list[str] = field(default_factory=list)   # filled by resolve()
+    needs_data: bool = True
+
+
+def data_dir(explicit: str | None = None) -> Path:
+    return Path(explicit or os.environ.get("MOREA_SHARED_DATA_DIR") or DEFAULT_DATA)
+
+
+def make(name: str, quick: bool) -> Pair:
+    P = common.PARAMS_DIR
+    if name == "lung":
+        return Pair("lung", "lung CT pair (fixed baseline, moving followup; 51 landmark pairs)",
+                    P / "morea_lung.toml", "lungs",
+                    [Criterion("tre_mean_mm", False, "TRE mean (mm)"),
+                     Criterion("dice:lungs", True, "lungs Dice"),
+                     Criterion("hd95:lungs", False, "lungs HD95 (mm)")])
+    if name == "abdomen":
+        s = "Stomach_duo_CBCT"
+        return Pair("abdomen", "abdominal CBCT pair (fixed CB02, moving CB07)",
+                    P / "morea_abdomen.toml", s,
+                    [Criterion(f"dice:{s}", True, "stomach Dice"),
+                     Criterion(f"hd95:{s}", False, "stomach HD95 (mm)")])
+    if name == "phantom":
+        return Pair("phantom", "synthetic pelvis phantom (bladder filling), `morea phantom`",
+                    P / ("morea_phantom_quick.toml" if quick else "morea_phantom.toml"), "bladder",
+                    [Criterion("dice:bladder", True, "bladder Dice"),
+                     Criterion("hd95:bladder", False, "bladder HD95 (mm)")],
+                    needs_data=False)
+    raise SystemExit(f"unknown pair {name!r} (lung, abdomen, phantom)")
+
+
+def resolve(pair: Pair, data: Path, out: Path, morea: str) -> None:
+    """Fills pair.raw_args; for the phantom writes the raw pair under out/raw."""
+    if pair.name == "lung":
+        d = data / "lung-ct-pair"
+        _require(d)
+        pair.raw_args = [
+            "--fixed", str(d / "baseline.mha"), "--moving", str(d / "followup.mha"),
+            "--fixed-structure", f"lungs={d / 'baseline_lung_mask.mha'}",
+            "--moving-structure", f"lungs={d / 'followup_lung_mask.mha'}",
+            "--fixed-landmarks", str(d / "baseline_landmarks51_mm.txt"),
+            "--moving-landmarks", str(d / "followup_landmarks51_mm.txt")]
+    elif pair.name == "abdomen":
+        d = data / "abdomen-cbct-pair"
+        _require(d)
+        args = ["--fixed", str(d / "CB02.mha"), "--moving", str(d / "CB07.mha")]
+        for s in ("Stomach_duo_CBCT", "Bowel_sm_CBCT"):
+            args += ["--fixed-structure", f"{s}={d / 'CB02_labels.mha'}:{s}",
+                     "--moving-structure", f"{s}={d / 'CB07_masks' / (s + '.mha')}"]
+        pair.raw_args = args
+    else:
+        raw = out / "raw"
+        if not (raw / "phantom.json").exists():
+            common.run_command([morea, "phantom", "-o", raw], out / "logs" / "phantom.log")
+        pair.raw_args = ["--problem", str(raw)]
+
+
+def _require(d: Path) -> None:
+    if not d.is_dir():
+        raise FileNotFoundError(f"{d} not found (pass --data DIR or set MOREA_SHARED_DATA_DIR)")

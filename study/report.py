@@ -1,0 +1,258 @@
+"""Tables (CSV, Markdown), Mann-Whitney U tests, plots and renders of a study."""
+from __future__ import annotations
+
+import csv
+import math
+import platform
+from pathlib import Path
+
+import numpy as np
+
+from . import evaluation
+
+METHOD_LABEL = {"morea": "MOREA", "elastix": "elastix", "ants": "ANTs SyN",
+                "rigid baseline": "rigid baseline"}
+
+
+def _fmt(v, digits=3):
+    if v is None or v == "":
+        return ""
+    if isinstance(v, float):
+        if math.isnan(v):
+            return "nan"
+        if v != 0 and abs(v) < 1e-3:
+            return f"{v:.1e}"
+        return f"{v:.{digits}f}"
+    return str(v)
+
+
+def write_csv(path: Path, rows: list[dict]) -> None:
+    cols = []
+    for r in rows:
+        for k in r:
+            if k not in cols:
+                cols.append(k)
+    with open(path, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=cols)
+        w.writeheader()
+        for r in rows:
+            w.writerow(r)
+
+
+def score_columns(rows: list[dict], pair) -> list[str]:
+    structures = sorted({k.split(":", 1)[1] for r in rows for k in r if k.startswith("dice:")},
+                        key=lambda s: (s != pair.primary_structure, s))
+    cols = []
+    for s in structures:
+        cols += [f"dice:{s}", f"hd95:{s}", f"hd:{s}"]
+    if any("tre_mean_mm" in r for r in rows):
+        cols.insert(0, "tre_mean_mm")
+    cols += ["jacobian_nonpositive_fraction", "ic_mean_mm", "seconds"]
+    return cols
+
+
+def column_label(c: str) -> str:
+    if ":" in c:
+        kind, s = c.split(":", 1)
+        return f"{s} {'Dice' if kind == 'dice' else kind.upper() + ' mm'}"
+    return {"tre_mean_mm": "TRE mean mm", "jacobian_nonpositive_fraction": "Jacobian <= 0",
+            "ic_mean_mm": "inverse consistency mm", "seconds": "time s"}.get(c, c)
+
+
+def mann_whitney(chosen: dict, pair) -> list[dict]:
+    from scipy.stats import mannwhitneyu
+    out = []
+    if "morea" not in chosen:
+        return out
+    morea_rows = chosen["morea"][1]
+    for comp in ("elastix", "ants"):
+        if comp not in chosen:
+            continue
+        for crit in pair.criteria:
+            a = [r[crit.column] for r in morea_rows if r.get(crit.column) is not None]
+            b = [r[crit.column] for r in chosen[comp][1] if r.get(crit.column) is not None]
+            if not a or not b:
+                continue
+            if len(set(a + b)) == 1:
+                p = 1.0
+            else:
+                p = float(mannwhitneyu(a, b, alternative="two-sided").pvalue)
+            ma, mb = float(np.median(a)), float(np.median(b))
+            better = (ma > mb) if crit.higher_is_better else (ma < mb)
+            out.append({"comparison": f"MOREA vs {METHOD_LABEL[comp]} ({chosen[comp][0]})",
+                        "score": crit.label, "n_morea": len(a), "n_other": len(b),
+                        "median_morea": ma, "median_other": mb, "p_value": p,
+                        "significant_at_0.025": p < 0.025,
+                        "direction": ("MOREA better" if better else
+                                      ("equal medians" if ma == mb else "MOREA worse"))})
+    return out
+
+
+def summary_rows(chosen: dict, baseline: dict | None, cols: list[str]) -> list[dict]:
+    rows = []
+    if baseline:
+        rows.append({"method": "rigid baseline", "config": "", "n": 1,
+                     **{c: baseline.get(c) for c in cols}})
+    for m in ("morea", "elastix", "ants"):
+        if m not in chosen:
+            continue
+        cfg, rs = chosen[m]
+        row = {"method": METHOD_LABEL[m], "config": cfg, "n": len(rs)}
+        for c in cols:
+            vals = [r[c] for r in rs if r.get(c) is not None]
+            if vals:
+                row[c] = float(np.median(vals))
+                row[c + " (min-max)"] = (float(np.min(vals)), float(np.max(vals)))
+        rows.append(row)
+    return rows
+
+
+def markdown_table(header: list[str], rows: list[list]) -> str:
+    lines = ["| " + " | ".join(header) + " |", "| " + " | ".join("---" for _ in header) + " |"]
+    for r in rows:
+        lines.append("| " + " | ".join(_fmt(v) for v in r) + " |")
+    return "\n".join(lines)
+
+
+def parallel_coordinates(path: Path, chosen: dict, baseline: dict | None, pair,
+                         rows_all: list[dict]) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    cols = [c for c in score_columns(rows_all, pair)
+            if c.startswith(("dice:", "hd95:")) or c == "tre_mean_mm"]
+    if not cols:
+        return
+    series = []
+    colors = {"morea": "tab:red", "elastix": "tab:blue", "ants": "tab:green"}
+    for m, (cfg, rs) in chosen.items():
+        for r in rs:
+            series.append((m, [r.get(c, np.nan) for c in cols]))
+    if baseline:
+        series.append(("rigid baseline", [baseline.get(c, np.nan) for c in cols]))
+    data = np.array([s[1] for s in series], dtype=float)
+    lo, hi = np.nanmin(data, axis=0), np.nanmax(data, axis=0)
+    span = np.where(hi - lo > 1e-12, hi - lo, 1.0)
+    norm = (data - lo) / span
+    # Dice: higher is better; distances: lower is better -> flip so "up" is better.
+    for j, c in enumerate(cols):
+        if not c.startswith("dice:"):
+            norm[:, j] = 1.0 - norm[:, j]
+    fig, ax = plt.subplots(figsize=(1.6 * len(cols) + 2, 3.6), dpi=80)
+    seen = set()
+    for (m, _), y in zip(series, norm):
+        label = METHOD_LABEL.get(m, m)
+        ax.plot(range(len(cols)), y, color=colors.get(m, "black"),
+                ls="--" if m == "rigid baseline" else "-", alpha=0.8, marker="o", ms=3,
+                label=None if label in seen else label)
+        seen.add(label)
+    ax.set_xticks(range(len(cols)))
+    ax.set_xticklabels([f"{column_label(c)}\n[{_fmt(lo[j], 2)}, {_fmt(hi[j], 2)}]"
+                        for j, c in enumerate(cols)], fontsize=7)
+    ax.set_yticks([0, 1])
+    ax.set_yticklabels(["worst", "best"], fontsize=7)
+    ax.set_title(f"{pair.name}: chosen configurations, all seeds (axes scaled to their range)",
+                 fontsize=8)
+    ax.legend(fontsize=7, loc="best")
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+
+
+def renders(study, chosen: dict) -> dict:
+    """`morea evaluate --render` of seed 1 (or the first seed) of each chosen
+    configuration and of the baseline."""
+    out = {}
+    rdir = study.out / "renders"
+    rdir.mkdir(exist_ok=True)
+    focus = study.pair.primary_structure
+    base_prefix = rdir / "baseline"
+    if not (rdir / "baseline_coronal.png").exists():
+        evaluation.evaluate(study.morea, study.problem, rdir / "baseline.json",
+                            render=base_prefix, focus=focus)
+    out["rigid baseline"] = base_prefix
+    for m, (cfg, rs) in chosen.items():
+        seed = min(r["seed"] for r in rs)
+        d = study.run_dir(m, None if m == "morea" else float(cfg[1:]), seed)
+        prefix = rdir / f"{m}_{cfg}_seed{seed}"
+        if not Path(str(prefix) + "_coronal.png").exists():
+            evaluation.evaluate(study.morea, study.problem, rdir / f"{m}.json",
+                                d / "fixed_to_moving.nii.gz", d / "moving_to_fixed.nii.gz",
+                                render=prefix, focus=focus)
+        out[m] = prefix
+    return out
+
+
+def render_montage(path: Path, rend: dict) -> None:
+    """One PNG: rows axial / coronal / sagittal, a column per method (fixed
+    contours and warped moving contours as `morea evaluate --render` draws them)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.image as mpimg
+    import matplotlib.pyplot as plt
+    order = [k for k in ("rigid baseline", "morea", "elastix", "ants") if k in rend]
+    views = ("axial", "coronal", "sagittal")
+    fig, axes = plt.subplots(len(views), len(order), figsize=(2.2 * len(order), 6.2), dpi=90,
+                             squeeze=False)
+    for j, k in enumerate(order):
+        for i, v in enumerate(views):
+            ax = axes[i][j]
+            p = Path(f"{rend[k]}_{v}.png")
+            if p.exists():
+                ax.imshow(mpimg.imread(str(p)), interpolation="nearest")
+            ax.set_xticks([])
+            ax.set_yticks([])
+            if i == 0:
+                ax.set_title(f"{METHOD_LABEL.get(k, k)}\n{Path(str(rend[k])).name}", fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+
+
+def write_all(study, rows: list[dict], chosen: dict) -> None:
+    pair = study.pair
+    out = study.out
+    write_csv(out / "results.csv", rows)
+    baseline = next((r for r in rows if r["method"] == "rigid baseline"), None)
+    cols = score_columns(rows, pair)
+    summ = summary_rows(chosen, baseline, cols)
+    write_csv(out / "summary.csv", [{k: (f"{v[0]}..{v[1]}" if isinstance(v, tuple) else v)
+                                     for k, v in r.items()} for r in summ])
+    tests = mann_whitney(chosen, pair)
+    write_csv(out / "tests.csv", tests)
+    parallel_coordinates(out / "parallel_coordinates.png", chosen, baseline, pair, rows)
+    try:
+        rend = renders(study, chosen)
+        render_montage(out / "renders.png", rend)
+    except Exception as exc:
+        rend = {}
+        study.say(f"renders failed: {exc}")
+
+    md = [f"# Comparison study: {pair.description}", ""]
+    md.append(f"Machine: {platform.node() or 'unknown'} ({platform.machine()}), "
+              f"{study.args.threads} threads per run; mode: {'quick' if study.args.quick else 'full'}.")
+    md.append(f"Problem: `{study.problem}` (preprocessed with `{pair.morea_parameters.name}`); "
+              f"every method scored by `morea evaluate` on it.")
+    md.append("")
+    md.append("## Chosen configurations (median over seeds; min-max in summary.csv)")
+    header = ["method", "config", "n"] + [column_label(c) for c in cols]
+    md.append(markdown_table(header, [[r.get("method"), r.get("config"), r.get("n")] +
+                                      [r.get(c) for c in cols] for r in summ]))
+    md.append("")
+    md.append("## Mann-Whitney U, two-sided (Bonferroni alpha 0.025)")
+    md.append(markdown_table(["comparison", "score", "median MOREA", "median other", "p",
+                              "p < 0.025", "direction"],
+                             [[t["comparison"], t["score"], t["median_morea"], t["median_other"],
+                               t["p_value"], "yes" if t["significant_at_0.025"] else "no",
+                               t["direction"]] for t in tests]))
+    md.append("")
+    md.append("## Regularisation sweep (seed 1)")
+    sweep = [r for r in rows if r["method"] in ("elastix", "ants") and r.get("seed") == 1]
+    md.append(markdown_table(["method", "config"] + [column_label(c) for c in cols],
+                             [[METHOD_LABEL[r["method"]], r["config"]] +
+                              [("FAILED" if r.get("failed") else r.get(c)) for c in cols]
+                              for r in sorted(sweep, key=lambda r: (r["method"], r["config"]))]))
+    md.append("")
+    md.append("## All runs: results.csv. Renders: " +
+              ", ".join(f"{METHOD_LABEL.get(k, k)} `{Path(v).name}_*.png`" for k, v in rend.items()))
+    (out / "report.md").write_text("\n".join(md) + "\n")
