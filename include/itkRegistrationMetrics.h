@@ -12,6 +12,7 @@
 
 #include "itkMOREATypes.h"
 
+#include <array>
 #include <cstddef>
 #include <vector>
 
@@ -24,15 +25,40 @@ namespace morea
 double
 ComputeDice(const MaskType * a, const MaskType * b, const MaskType * region = nullptr);
 
-/** Symmetric surface distances between two masks on one grid, in mm. */
+/** Symmetric surface distances between two masks on one grid, in mm, by the
+ *  method of DeepMind's surface-distance package as pymia 0.3.4 computes it
+ *  (`HausdorffDistance`): a mask's surface is the set of voxel corners whose
+ *  2x2x2 neighbourhood holds inside and outside voxels (the space beyond the
+ *  image is outside), each weighted by its surface area (SurfaceElementAreas);
+ *  directed distances run from each surface element of one mask to the nearest
+ *  surface element of the other (exact Euclidean distance transform).
+ *  With a region, only surface elements whose whole neighbourhood (within the
+ *  image) lies in the region are scored; they are still measured to the other
+ *  mask's whole surface (a direction without scored elements adds nothing, and
+ *  all three scores are 0 when neither has any). Throws when a mask is empty. */
 struct SurfaceDistanceScores
 {
-  double hausdorff{ 0.0 };   ///< maximum of both directed distances
-  double hausdorff95{ 0.0 }; ///< 95th percentile Hausdorff distance
+  double hausdorff{ 0.0 };   ///< maximum of both directed maxima
+  /** Maximum of both directed 95th percentiles; a directed percentile is the
+   *  smallest distance whose cumulative area share (distances ascending)
+   *  reaches 0.95, without interpolation (as numpy.searchsorted in pymia). */
+  double hausdorff95{ 0.0 };
+  /** Area-weighted mean of the distances of both directions together. */
   double meanSurfaceDistance{ 0.0 };
 };
 SurfaceDistanceScores
 ComputeSurfaceDistances(const MaskType * a, const MaskType * b, const MaskType * region = nullptr);
+
+/** Area (mm^2) of the surface inside one cell of the voxel-corner grid, per
+ *  neighbourhood code. The cell spans the centres of 2x2x2 voxels; bit
+ *  (dx + 2 dy + 4 dz) of the code is set when the voxel at offset (dx, dy, dz)
+ *  is inside. The surface is a marching-cubes surface through the midpoints of
+ *  the cell edges that join an inside and an outside centre (see
+ *  itkSurfaceElements.cxx for the triangulation). Codes 0 and 255 have area 0.
+ *  Throws unless every spacing is positive and finite. */
+using SurfaceElementAreaTable = std::array<double, 256>;
+SurfaceElementAreaTable
+SurfaceElementAreas(const MaskType::SpacingType & spacing);
 
 /** Target registration error of landmark pairs, in mm. */
 struct LandmarkErrorScores

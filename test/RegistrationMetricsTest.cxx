@@ -126,12 +126,16 @@ ItkHausdorff(const MaskType * a, const MaskType * b)
   return filter->GetHausdorffDistance();
 }
 
-/** Brute force: surface voxels (inside, with a face neighbour outside or at the
- *  image edge) with their exposed face area, and all-pairs directed distances. */
+/** Brute force: surface elements on the voxel-corner grid, as documented in
+ *  itkRegistrationMetrics.h. Corner c = 0..size per axis lies at continuous
+ *  index c - 1/2 and its code has bit (dx + 2 dy + 4 dz) set when voxel
+ *  c - 1 + (dx, dy, dz) is inside (voxels beyond the image are outside); codes
+ *  other than 0 and 255 are surface elements, weighted by the code's area. */
 struct BruteSurface
 {
   std::vector<std::array<double, 3>> points; // physical (origin 0, identity direction)
   std::vector<double>                areas;
+  std::vector<unsigned int>          codes;
 };
 
 BruteSurface
@@ -140,32 +144,29 @@ BruteSurfaceOf(const MaskType * mask)
   BruteSurface s;
   const auto   size = mask->GetLargestPossibleRegion().GetSize();
   const auto   sp = mask->GetSpacing();
-  const double face[3]{ sp[1] * sp[2], sp[0] * sp[2], sp[0] * sp[1] };
-  for (itk::ImageRegionConstIteratorWithIndex<MaskType> it(mask, mask->GetLargestPossibleRegion()); !it.IsAtEnd();
-       ++it)
+  const auto   table = SurfaceElementAreas(sp);
+  for (long z = 0; z <= static_cast<long>(size[2]); ++z)
   {
-    if (it.Get() == 0)
+    for (long y = 0; y <= static_cast<long>(size[1]); ++y)
     {
-      continue;
-    }
-    const auto i = it.GetIndex();
-    double     area{ 0.0 };
-    for (unsigned d = 0; d < 3; ++d)
-    {
-      for (int step : { -1, 1 })
+      for (long x = 0; x <= static_cast<long>(size[0]); ++x)
       {
-        auto n = i;
-        n[d] += step;
-        if (n[d] < 0 || n[d] >= static_cast<long>(size[d]) || mask->GetPixel(n) == 0)
+        unsigned int code{ 0 };
+        for (unsigned int bit = 0; bit < 8; ++bit)
         {
-          area += face[d];
+          const MaskType::IndexType v{ { x - 1 + (bit & 1), y - 1 + ((bit >> 1) & 1), z - 1 + ((bit >> 2) & 1) } };
+          if (mask->GetLargestPossibleRegion().IsInside(v) && mask->GetPixel(v) != 0)
+          {
+            code |= 1u << bit;
+          }
+        }
+        if (code != 0 && code != 255)
+        {
+          s.points.push_back({ { (x - 0.5) * sp[0], (y - 0.5) * sp[1], (z - 0.5) * sp[2] } });
+          s.areas.push_back(table[code]);
+          s.codes.push_back(code);
         }
       }
-    }
-    if (area > 0.0)
-    {
-      s.points.push_back({ { i[0] * sp[0], i[1] * sp[1], i[2] * sp[2] } });
-      s.areas.push_back(area);
     }
   }
   return s;
@@ -303,7 +304,7 @@ TEST(RegistrationMetrics, ConcentricSpheresDifferByRadii)
   // ITK measures between the full voxel sets, not the surfaces: same within a voxel here.
   EXPECT_NEAR(scores.hausdorff, ItkHausdorff(inner, outer), 1.0);
 
-  // The distance maps against an all-pairs search over the same surface voxels.
+  // The distance maps against an all-pairs search over the same surface elements.
   const auto sInner = BruteSurfaceOf(inner);
   const auto sOuter = BruteSurfaceOf(outer);
   const auto innerToOuter = BruteDirected(sInner, sOuter);
@@ -338,7 +339,8 @@ TEST(RegistrationMetrics, Hd95IgnoresAFewOutlierVoxels)
   const auto scores = ComputeSurfaceDistances(a, b);
   EXPECT_NEAR(scores.hausdorff, 20.0, 1e-4);
   EXPECT_NEAR(scores.hausdorff, ItkHausdorff(a, b), 1e-4);
-  // The strays carry 3 * 6 faces against the cube's 2400: far below 5 %.
+  // The strays carry 3 * 8 corner triangles of sqrt(3)/8 mm^2 (5.2 mm^2) against
+  // the cube's 2329 mm^2: far below 5 %.
   EXPECT_NEAR(scores.hausdorff95, 0.0, 1e-9);
   EXPECT_LT(scores.hausdorff95, 0.1 * scores.hausdorff);
 
@@ -354,14 +356,143 @@ TEST(RegistrationMetrics, SurfaceDistancesOfTinyMasks)
   const auto a = MakeMask(size, spacing, [](const Index3 & i) { return i == Index3{ { 3, 3, 3 } }; });
   const auto b = MakeMask(size, spacing, [](const Index3 & i) { return i == Index3{ { 3, 3, 6 } }; });
   const auto scores = ComputeSurfaceDistances(a, b);
+  // Each voxel's surface elements are its 8 corners (equal areas): the 4 facing
+  // the other voxel are 2 voxels (3 mm) from it, the other 4 are 4.5 mm.
   EXPECT_NEAR(scores.hausdorff, 4.5, 1e-4);
   EXPECT_NEAR(scores.hausdorff95, 4.5, 1e-4);
-  EXPECT_NEAR(scores.meanSurfaceDistance, 4.5, 1e-4);
+  EXPECT_NEAR(scores.meanSurfaceDistance, 3.75, 1e-4);
   // Masks made only of surface voxels, filling their whole bounding box.
   const auto c = MakeMask(size, spacing, Box({ { 0, 0, 0 } }, { { 2, 2, 2 } }));
   EXPECT_DOUBLE_EQ(ComputeSurfaceDistances(c, c).hausdorff, 0.0);
   const auto full = MakeMask(size, spacing, [](const Index3 &) { return true; });
   EXPECT_DOUBLE_EQ(ComputeSurfaceDistances(full, full).hausdorff95, 0.0);
+}
+
+// ---------------------------------------------------------------- surface elements
+
+TEST(RegistrationMetrics, SurfaceElementAreasOfSingleConfigurations)
+{
+  // Spacing (1, 2, 3): a plane with index-space area vector n has area
+  // |(2*3 n_x, 1*3 n_y, 1*2 n_z)| = |(6 n_x, 3 n_y, 2 n_z)|.
+  MaskType::SpacingType spacing;
+  spacing[0] = 1.0;
+  spacing[1] = 2.0;
+  spacing[2] = 3.0;
+  const auto area = SurfaceElementAreas(spacing);
+  const auto bit = [](int dx, int dy, int dz) { return 1u << (dx + 2 * dy + 4 * dz); };
+  EXPECT_DOUBLE_EQ(area[0], 0.0);
+  EXPECT_DOUBLE_EQ(area[255], 0.0);
+  // One corner: the triangle through three edge midpoints, n = (1, 1, 1) / 8.
+  EXPECT_NEAR(area[bit(0, 0, 0)], 7.0 / 8.0, 1e-12);
+  EXPECT_NEAR(area[bit(1, 1, 1)], 7.0 / 8.0, 1e-12);
+  // Two corners along x: a rectangle, 1 mm by half the (y, z) cell diagonal.
+  EXPECT_NEAR(area[bit(0, 0, 0) | bit(1, 0, 0)], std::sqrt(2.0 * 2.0 + 3.0 * 3.0) / 2.0, 1e-12);
+  // Four corners of the z = 0 face: the plane z = 1/2, 1 x 2 mm.
+  EXPECT_NEAR(area[bit(0, 0, 0) | bit(1, 0, 0) | bit(0, 1, 0) | bit(1, 1, 0)], 2.0, 1e-12);
+  // A corner and its three neighbours: the planar hexagon x + y + z = 3/2, n = (3, 3, 3) / 4.
+  EXPECT_NEAR(area[bit(0, 0, 0) | bit(1, 0, 0) | bit(0, 1, 0) | bit(0, 0, 1)], 0.75 * 7.0, 1e-12);
+  // Three corners of a face (an L): the triangle z = 1/2 (n = (0, 0, 1/2)) and the
+  // planar quadrilateral x + y + z = 3/2 (n = (3, 3, 3) / 8); a fan from the
+  // L's middle corner would give 3.6075 instead.
+  EXPECT_NEAR(area[bit(0, 0, 0) | bit(1, 0, 0) | bit(0, 1, 0)], 1.0 + 0.375 * 7.0, 1e-12);
+  // A chain along x, y, z: the planar quadrilateral with |n| = (1, 1, 1) / 2
+  // and two triangles with |n| = (1, 1, 0) / 4 and (0, 1, 1) / 4.
+  EXPECT_NEAR(area[bit(0, 0, 0) | bit(1, 0, 0) | bit(1, 1, 0) | bit(1, 1, 1)],
+              3.5 + (std::sqrt(45.0) + std::sqrt(13.0)) / 4.0,
+              1e-12);
+  // Ambiguous configurations keep the corners of the smaller set apart.
+  EXPECT_NEAR(area[bit(0, 0, 0) | bit(1, 1, 0)], 2 * 7.0 / 8.0, 1e-12);
+  EXPECT_NEAR(area[bit(0, 0, 0) | bit(1, 1, 1)], 2 * 7.0 / 8.0, 1e-12);
+  // A code and its complement have one surface.
+  for (unsigned int code = 0; code < 256; ++code)
+  {
+    EXPECT_NEAR(area[code], area[255 - code], 1e-12) << code;
+  }
+
+  // Unit spacing: the one-corner triangle has area sqrt(3)/8.
+  MaskType::SpacingType unit;
+  unit.Fill(1.0);
+  EXPECT_NEAR(SurfaceElementAreas(unit)[bit(0, 1, 0)], std::sqrt(3.0) / 8.0, 1e-12);
+  MaskType::SpacingType bad = spacing;
+  bad[1] = 0.0;
+  EXPECT_THROW(SurfaceElementAreas(bad), itk::ExceptionObject);
+}
+
+TEST(RegistrationMetrics, SurfaceElementAreasOfABoxAddUpToItsChamferedSurface)
+{
+  // A 3 x 4 x 5 voxel box, spacing (1, 2, 3). The marching-cubes surface runs on
+  // the voxel faces (at the half-voxel planes) but chamfers every box edge and
+  // corner within the half voxel: flat parts (n - 1) x (m - 1) cells per face,
+  // edge chamfers of (n - 1) cells of half a cell diagonal, 8 corner triangles.
+  const auto   box = MakeMask({ { 9, 10, 11 } }, { { 1, 2, 3 } }, Box({ { 2, 3, 4 } }, { { 5, 7, 9 } }));
+  const auto   surface = BruteSurfaceOf(box);
+  const double faces = 2.0 * (2 * 3 * 1 * 2 + 2 * 4 * 1 * 3 + 3 * 4 * 2 * 3);
+  const double edges = 4.0 * (2 * 1 * std::sqrt(2.0 * 2 + 3 * 3) / 2 + 3 * 2 * std::sqrt(1.0 + 3 * 3) / 2 +
+                              4 * 3 * std::sqrt(1.0 + 2 * 2) / 2);
+  const double corners = 8.0 * 7.0 / 8.0;
+  double       total{ 0.0 };
+  for (const double a : surface.areas)
+  {
+    total += a;
+  }
+  EXPECT_NEAR(total, faces + edges + corners, 1e-9); // 329.035 mm^2 (pymia: the same)
+  // Less than the 378 mm^2 of the voxels' outer faces, by the chamfers.
+  EXPECT_LT(total, 2.0 * (3 * 1 * 4 * 2 + 3 * 1 * 5 * 3 + 4 * 2 * 5 * 3));
+  EXPECT_EQ(surface.points.size(), 4u * 5u * 6u - 2u * 3u * 4u);
+}
+
+TEST(RegistrationMetrics, Hd95TakesTheAreaWeightedPercentile)
+{
+  // A: 2 x 2 x 2 voxels, B: 3 x 3 x 3 voxels sharing A's low corner; spacing (1, 2, 3).
+  // From B's far corners (index 5.5 against A's 4.5) to A's surface: the corner
+  // (5.5, 5.5, 5.5): sqrt(1 + 4 + 9), area 7/8; the other 3 elements of the edge
+  // y = z = 5.5: sqrt(4 + 9), area 7/8 + 2 sqrt(13)/2 = 4.48; the 3 elements of
+  // the edge x = z = 5.5 below the corner: sqrt(1 + 9), area 7/8 + 2 sqrt(10) =
+  // 7.20; everything else <= 3 mm. B's area: 88 + 4 (sqrt(13) + 2 sqrt(10) +
+  // 3 sqrt(5)) + 7 = 161.55, and 5 % of it = 8.08 lies between 0.875 + 4.48 and
+  // 0.875 + 4.48 + 7.20: the 95th percentile is sqrt(10). (Counting elements
+  // instead, 3 of 56 from the top, would give sqrt(13).) A to B stays below 3 mm.
+  const std::array<unsigned long, 3> size{ { 9, 9, 9 } };
+  const std::array<double, 3>        spacing{ { 1, 2, 3 } };
+  const auto a = MakeMask(size, spacing, Box({ { 3, 3, 3 } }, { { 5, 5, 5 } }));
+  const auto b = MakeMask(size, spacing, Box({ { 3, 3, 3 } }, { { 6, 6, 6 } }));
+  const auto scores = ComputeSurfaceDistances(a, b);
+  EXPECT_NEAR(scores.hausdorff, std::sqrt(14.0), 1e-5);
+  EXPECT_NEAR(scores.hausdorff95, std::sqrt(10.0), 1e-5);
+  EXPECT_NEAR(ComputeSurfaceDistances(b, a).hausdorff95, std::sqrt(10.0), 1e-5);
+
+  // A 2 x 2 x 2 cube and the same moved up one voxel (3 mm): A's bottom layer
+  // of 9 elements (area 4 * 7/8 + 2 sqrt(13)/2 + 2 sqrt(10) + 2 = 15.43
+  // of 62.28) is 3 mm from B, A's top face centre 1 mm (its neighbours in x are
+  // on B's surface), the rest lies on B's surface.
+  const auto c = MakeMask(size, spacing, Box({ { 3, 3, 4 } }, { { 5, 5, 6 } }));
+  const auto shifted = ComputeSurfaceDistances(a, c);
+  EXPECT_NEAR(shifted.hausdorff, 3.0, 1e-5);
+  EXPECT_NEAR(shifted.hausdorff95, 3.0, 1e-5);
+  const double areaA = 8 * 7.0 / 8 + 4 * (std::sqrt(13.0) / 2 + std::sqrt(10.0) + 3 * std::sqrt(5.0) / 2) +
+                       2 * (6.0 + 3.0 + 2.0);
+  const double bottom = 4 * 7.0 / 8 + std::sqrt(13.0) + 2 * std::sqrt(10.0) + 2.0;
+  // Both directions alike: mean = (3 * bottom + 1 * 2) / areaA.
+  EXPECT_NEAR(shifted.meanSurfaceDistance, (3.0 * bottom + 2.0) / areaA, 1e-5);
+}
+
+TEST(RegistrationMetrics, SurfaceDistanceRegionDropsElementsThatReadVoxelsOutsideIt)
+{
+  // Single voxels at x = 3 (A) and x = 4 (B), spacing (1, 2, 3); the region is x >= 4.
+  // A's corners (x = 2.5 and 3.5) read voxel 3, outside the region: none is
+  // scored. B's corners at x = 3.5 read voxel 3 too; those at x = 4.5 are scored
+  // and lie 1 mm from A's corners at x = 3.5.
+  const std::array<unsigned long, 3> size{ { 8, 8, 8 } };
+  const std::array<double, 3>        spacing{ { 1, 2, 3 } };
+  const auto a = MakeMask(size, spacing, [](const Index3 & i) { return i == Index3{ { 3, 4, 4 } }; });
+  const auto b = MakeMask(size, spacing, [](const Index3 & i) { return i == Index3{ { 4, 4, 4 } }; });
+  const auto region = MakeMask(size, spacing, [](const Index3 & i) { return i[0] >= 4; });
+  const auto scores = ComputeSurfaceDistances(a, b, region);
+  EXPECT_NEAR(scores.hausdorff, 1.0, 1e-6);
+  EXPECT_NEAR(scores.hausdorff95, 1.0, 1e-6);
+  EXPECT_NEAR(scores.meanSurfaceDistance, 1.0, 1e-6); // no element at distance 0 is scored
+  // Without the region, half of the corners coincide.
+  EXPECT_NEAR(ComputeSurfaceDistances(a, b).meanSurfaceDistance, 0.5, 1e-6);
 }
 
 TEST(RegistrationMetrics, SurfaceDistancesRejectEmptyAndMismatchedMasks)

@@ -7,6 +7,7 @@
 #include "itkRegistrationMetrics.h"
 
 #include "itkMOREAImageIO.h"
+#include "itkSurfaceElements.h"
 
 #include "itkDisplacementFieldTransform.h"
 #include "itkIdentityTransform.h"
@@ -97,16 +98,6 @@ private:
   const MaskType::PixelType * m_Buffer{ nullptr };
 };
 
-/** Voxels of a mask that touch the outside through a face (6-neighbourhood; the
- *  space beyond the image counts as outside, as pymia's zero padding does),
- *  restricted to a bounding box, with the area of their exposed faces. */
-struct SurfaceVoxels
-{
-  MaskType::Pointer   image;   ///< 1 at surface voxels, on the bounding-box grid
-  std::vector<double> area;    ///< exposed face area (mm^2) per bounding-box voxel
-  SizeValueType       count{ 0 };
-};
-
 /** Bounding box (inclusive) of the union of two masks' inside voxels. */
 bool
 UnionBoundingBox(const MaskType * a, const MaskType * b, IndexArray & lower, IndexArray & upper)
@@ -140,76 +131,9 @@ UnionBoundingBox(const MaskType * a, const MaskType * b, IndexArray & lower, Ind
   return any;
 }
 
-SurfaceVoxels
-ExtractSurface(const MaskType * mask, const IndexArray & lower, const IndexArray & upper)
-{
-  const auto   size = mask->GetLargestPossibleRegion().GetSize();
-  const auto   spacing = mask->GetSpacing();
-  const auto * in = mask->GetBufferPointer();
-  // Area of a face whose normal is along axis d.
-  const std::array<double, Dimension> faceArea{ { spacing[1] * spacing[2], spacing[0] * spacing[2],
-                                                  spacing[0] * spacing[1] } };
-  const std::array<SizeValueType, Dimension> stride{ { 1, size[0], size[0] * size[1] } };
-
-  MaskType::SizeType boxSize;
-  MaskType::IndexType boxStart;
-  for (unsigned int d = 0; d < Dimension; ++d)
-  {
-    boxSize[d] = upper[d] - lower[d] + 1;
-    boxStart[d] = static_cast<IndexValueType>(lower[d]);
-  }
-  SurfaceVoxels surface;
-  surface.image = MaskType::New();
-  surface.image->SetRegions(MaskType::RegionType{ boxSize });
-  surface.image->SetSpacing(spacing);
-  surface.image->SetDirection(mask->GetDirection());
-  MaskType::PointType boxOrigin;
-  mask->TransformIndexToPhysicalPoint(boxStart, boxOrigin);
-  surface.image->SetOrigin(boxOrigin);
-  surface.image->Allocate(true);
-  surface.area.assign(surface.image->GetLargestPossibleRegion().GetNumberOfPixels(), 0.0);
-  auto * out = surface.image->GetBufferPointer();
-
-  SizeValueType o{ 0 };
-  for (SizeValueType z = lower[2]; z <= upper[2]; ++z)
-  {
-    for (SizeValueType y = lower[1]; y <= upper[1]; ++y)
-    {
-      for (SizeValueType x = lower[0]; x <= upper[0]; ++x, ++o)
-      {
-        const SizeValueType i = x + stride[1] * y + stride[2] * z;
-        if (in[i] == 0)
-        {
-          continue;
-        }
-        const IndexArray idx{ { x, y, z } };
-        double           exposed{ 0.0 };
-        for (unsigned int d = 0; d < Dimension; ++d)
-        {
-          if (idx[d] == 0 || in[i - stride[d]] == 0)
-          {
-            exposed += faceArea[d];
-          }
-          if (idx[d] + 1 == size[d] || in[i + stride[d]] == 0)
-          {
-            exposed += faceArea[d];
-          }
-        }
-        if (exposed > 0.0)
-        {
-          out[o] = 1;
-          surface.area[o] = exposed;
-          ++surface.count;
-        }
-      }
-    }
-  }
-  return surface;
-}
-
-/** Euclidean distance (mm) from every voxel to the nearest voxel of `set`.
+/** Euclidean distance (mm) from every grid point to the nearest point of `set`.
  *  Maurer's transform is exact; outside the set its value is the distance to the
- *  nearest set voxel (the nearest one always borders the outside), inside the
+ *  nearest set point (the nearest one always borders the outside), inside the
  *  set it is <= 0 and callers use 0 there. */
 ImageType::Pointer
 DistanceToSet(const MaskType * set)
@@ -229,45 +153,23 @@ DistanceToSet(const MaskType * set)
 
 struct DirectedDistances
 {
-  std::vector<std::pair<double, double>> distanceAndArea;
+  std::vector<std::pair<double, double>> distanceAndArea; ///< ascending
 };
 
-/** Distances from the scored surface voxels of `from` to the surface of `to`. */
+/** Distances from the scored surface elements of `from` to the surface of `to`
+ *  (both on one corner grid), with the elements' areas. */
 DirectedDistances
-Directed(const SurfaceVoxels &       from,
-         const SurfaceVoxels &       to,
-         const ImageType *           toDistance,
-         const RegionTest &          inRegion,
-         const MaskType::SizeType &  fullSize,
-         const IndexArray &          lower)
+Directed(const detail::SurfaceElements & from, const detail::SurfaceElements & to, const ImageType * toDistance)
 {
   DirectedDistances result;
-  result.distanceAndArea.reserve(from.count);
-  const auto   boxSize = from.image->GetLargestPossibleRegion().GetSize();
-  const auto * fromBuffer = from.image->GetBufferPointer();
-  const auto * toBuffer = to.image->GetBufferPointer();
+  result.distanceAndArea.reserve(from.scored.size());
+  const auto * toBuffer = to.grid->GetBufferPointer();
   const auto * distance = toDistance->GetBufferPointer();
-  SizeValueType o{ 0 };
-  for (SizeValueType z = 0; z < boxSize[2]; ++z)
+  for (const auto & element : from.scored)
   {
-    for (SizeValueType y = 0; y < boxSize[1]; ++y)
-    {
-      for (SizeValueType x = 0; x < boxSize[0]; ++x, ++o)
-      {
-        if (fromBuffer[o] == 0)
-        {
-          continue;
-        }
-        const SizeValueType full =
-          (x + lower[0]) + fullSize[0] * ((y + lower[1]) + fullSize[1] * (z + lower[2]));
-        if (!inRegion(full))
-        {
-          continue;
-        }
-        const double d = toBuffer[o] != 0 ? 0.0 : std::max(0.0, static_cast<double>(distance[o]));
-        result.distanceAndArea.emplace_back(d, from.area[o]);
-      }
-    }
+    const auto   o = element.offset;
+    const double d = toBuffer[o] != 0 ? 0.0 : std::max(0.0, static_cast<double>(distance[o]));
+    result.distanceAndArea.emplace_back(d, element.area);
   }
   std::sort(result.distanceAndArea.begin(), result.distanceAndArea.end());
   return result;
@@ -414,32 +316,34 @@ ComputeDice(const MaskType * a, const MaskType * b, const MaskType * region)
   return 2.0 * static_cast<double>(both) / static_cast<double>(countA + countB);
 }
 
-/* Surface distances, following pymia (rundherum/pymia,
- * pymia/evaluation/metric/base.py `Distances` and binary.py `HausdorffDistance`),
- * which ports DeepMind's surface-distance package:
- *  - each mask's surface is a set of surface elements weighted by their area;
+/* Surface distances, following pymia 0.3.4 (pymia/evaluation/metric/base.py
+ * `Distances`, categorical.py `HausdorffDistance`), which ports DeepMind's
+ * surface-distance package:
+ *  - a mask's surface elements are the voxel corners whose 2x2x2 neighbourhood
+ *    holds inside and outside voxels (outside the image counts as outside, like
+ *    pymia's zero padding), each weighted by the surface area of its
+ *    neighbourhood code (itkSurfaceElements.cxx);
  *  - the directed distances run from every surface element of one mask to the
  *    nearest surface element of the other (an exact Euclidean distance transform
- *    of the other surface, in mm);
+ *    of the other surface on the corner grid, in mm);
  *  - HD_p of one direction is the smallest distance whose cumulative area share
  *    (distances sorted ascending) reaches p/100 (np.searchsorted, side left),
  *    without interpolation; HD_p = max of the two directed values;
- *    HD (p = 100) is therefore the max of both directed maxima.
- * Difference: pymia places surface elements on the voxel-corner grid (2x2x2
- * neighbourhood codes with marching-cube areas); here a surface element is an
- * inside voxel with a face-neighbour outside (or at the image edge, like
- * pymia's zero padding), at its centre, weighted by the area of its exposed
- * faces. Values agree with pymia to within about a voxel.
- * The mean surface distance is the area-weighted mean over both directions.
- * With a region, only surface elements inside the region are scored; they
- * are still measured to the other mask's whole surface. */
+ *    HD (p = 100) is the max of both directed maxima.
+ * The mean surface distance is the area-weighted mean over both directions
+ * together (pymia's package has no such metric; the surface-distance package
+ * reports the two directed means).
+ * With a region, only the surface elements whose 2x2x2 neighbourhood lies in
+ * the region (ignoring voxels beyond the image) are scored, so no scored
+ * element depends on a voxel outside the region; they are still measured to
+ * the other mask's whole surface. */
 SurfaceDistanceScores
 ComputeSurfaceDistances(const MaskType * a, const MaskType * b, const MaskType * region)
 {
   RequireImage(a, "first surface-distance mask");
   RequireImage(b, "second surface-distance mask");
   RequireSameGrid(a, "the first surface-distance mask", b, "the second surface-distance mask");
-  const RegionTest inRegion{ region, a, "the surface-distance masks" };
+  const RegionTest checkRegion{ region, a, "the surface-distance masks" }; // validates `region`
 
   IndexArray lower;
   IndexArray upper;
@@ -447,10 +351,11 @@ ComputeSurfaceDistances(const MaskType * a, const MaskType * b, const MaskType *
   {
     Fail("surface distances: both masks are empty");
   }
-  // Every surface lies in the union's bounding box, and Euclidean distances
-  // between points in it do not depend on anything outside, so work on the box.
-  const auto surfaceA = ExtractSurface(a, lower, upper);
-  const auto surfaceB = ExtractSurface(b, lower, upper);
+  // Every surface element lies on the corners of the union's bounding box, and
+  // Euclidean distances between them do not depend on anything outside it.
+  const auto areas = SurfaceElementAreas(a->GetSpacing());
+  const auto surfaceA = detail::ExtractSurfaceElements(a, region, lower, upper, areas);
+  const auto surfaceB = detail::ExtractSurfaceElements(b, region, lower, upper, areas);
   if (surfaceA.count == 0)
   {
     Fail("surface distances: the first mask is empty");
@@ -459,11 +364,8 @@ ComputeSurfaceDistances(const MaskType * a, const MaskType * b, const MaskType *
   {
     Fail("surface distances: the second mask is empty");
   }
-  const auto distanceToA = DistanceToSet(surfaceA.image);
-  const auto distanceToB = DistanceToSet(surfaceB.image);
-  const auto fullSize = a->GetLargestPossibleRegion().GetSize();
-  const auto aToB = Directed(surfaceA, surfaceB, distanceToB, inRegion, fullSize, lower);
-  const auto bToA = Directed(surfaceB, surfaceA, distanceToA, inRegion, fullSize, lower);
+  const auto aToB = Directed(surfaceA, surfaceB, DistanceToSet(surfaceB.grid));
+  const auto bToA = Directed(surfaceB, surfaceA, DistanceToSet(surfaceA.grid));
 
   SurfaceDistanceScores scores;
   double                weightedSum{ 0.0 };
