@@ -2,6 +2,7 @@
 
     python3 -m study run --pair lung|abdomen|phantom --out DIR [--quick]
     python3 -m study report --pair ... --out DIR        (tables and plots again)
+    python3 -m study rescore --pair ... --out DIR       (scores again, then report)
 
 Steps (each run is skipped when its scores.json exists, so a killed study resumes):
  1. `morea preprocess` with the MOREA parameter file of the pair -> DIR/problem,
@@ -14,6 +15,10 @@ Steps (each run is skipped when its scores.json exists, so a killed study resume
  5. results.csv (every run), tables (CSV, Markdown), two-sided Mann-Whitney U
     tests of MOREA against each competitor (Bonferroni: alpha 0.05 / 2 = 0.025),
     a parallel-coordinates plot and renders of seed 1 of each method.
+
+`rescore` runs only `morea evaluate` again (after a change of its metrics) on the
+baseline and on every finished run that still has both fields, replacing their
+scores.json; nothing is registered again, and the run times stay those of run.json.
 """
 from __future__ import annotations
 
@@ -159,6 +164,50 @@ class Study:
                 best, best_val = w, v
         return best
 
+    # -- rescore ---------------------------------------------------------------
+    def rescore(self) -> dict:
+        """Scores the baseline and every run directory with scores.json and both
+        fields again with the current `morea evaluate`, with the border margin the
+        old scores were computed with; registers nothing (failed runs and run.json,
+        hence the run times, are left as they are). Returns {column kind: largest
+        absolute change} over all rescored rows (kind: "dice", "hd95", ...,
+        "tre_mean_mm", ...), and logs it."""
+        targets = []
+        if (self.out / "baseline" / "scores.json").exists():
+            targets.append((self.out / "baseline", None, None))
+        for scores in sorted((self.out / "runs").glob("*/*/seed*/scores.json")):
+            d = scores.parent
+            f, g = d / "fixed_to_moving.nii.gz", d / "moving_to_fixed.nii.gz"
+            if f.exists() and g.exists():
+                targets.append((d, f, g))
+            else:
+                self.say(f"rescore: {d.relative_to(self.out)} has no fields; its scores are kept")
+        changes: dict[str, float] = {}
+        for d, f, g in targets:
+            old = common.read_json(d / "scores.json")
+            new = evaluation.evaluate(self.morea, self.problem, d / "rescore.json", f, g,
+                                      border_margin=old.get("border_margin_mm"))
+            (d / "rescore.json").replace(d / "scores.json")
+            old_row, new_row = evaluation.flatten(old), evaluation.flatten(new)
+            for k in sorted(set(old_row) | set(new_row)):
+                kind = k.split(":", 1)[0]
+                a, b = old_row.get(k), new_row.get(k)
+                if a is None and b is None:
+                    delta = 0.0
+                elif a is None or b is None:
+                    delta = math.inf
+                elif math.isnan(a) or math.isnan(b):
+                    delta = 0.0 if math.isnan(a) and math.isnan(b) else math.inf
+                else:
+                    delta = abs(b - a)
+                changes[kind] = max(changes.get(kind, 0.0), delta)
+        changed = {k: v for k, v in changes.items() if v > 1e-9}   # not summation noise
+        self.say(f"rescored {len(targets)} results with {self.morea}; changed: "
+                 + (", ".join(f"{k} (up to {v:.4g})" for k, v in sorted(changed.items()))
+                    or "nothing")
+                 + "; unchanged: " + (", ".join(sorted(set(changes) - set(changed))) or "-"))
+        return changes
+
     # -- 5 ------------------------------------------------------------------
     def collect(self) -> list[dict]:
         rows = []
@@ -209,7 +258,7 @@ class Study:
 def main(argv=None):
     ap = argparse.ArgumentParser(prog="python3 -m study", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("command", choices=["run", "report"])
+    ap.add_argument("command", choices=["run", "report", "rescore"])
     ap.add_argument("--pair", required=True, choices=["lung", "abdomen", "phantom"])
     ap.add_argument("--out", required=True)
     ap.add_argument("--quick", action="store_true", help="tiny settings, one seed (CI)")
@@ -232,6 +281,8 @@ def main(argv=None):
     if args.command == "run":
         study.prepare()
         study.sweep_and_repeat()
+    elif args.command == "rescore":
+        study.rescore()
     study.report()
     study.say(f"done in {time.perf_counter() - start:.0f} s: {study.out / 'report.md'}")
     failed = [r for r in study.collect() if r.get("failed")]
