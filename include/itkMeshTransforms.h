@@ -14,6 +14,7 @@
 #include "itkDisplacementFieldTransform.h"
 #include "itkMOREATypes.h"
 #include "itkRigidPreAlignment.h"
+#include "morea/FieldFoldRepair.h"
 #include "morea/MeshRasterizer.h"
 #include "morea/TetrahedralMesh.h"
 #include "morea/VtuWriter.h"
@@ -99,13 +100,20 @@ struct MeshFields
   /** Rasterisation of fixedToMoving and movingToFixed (voxels outside the mesh). */
   ::morea::RasterizationReport fixedReport;
   ::morea::RasterizationReport movingReport;
+  /** Voxel-level fold repair of fixedToMoving and movingToFixed (see
+   *  morea/FieldFoldRepair.h): how many voxels were folded and smoothed. */
+  ::morea::FieldFoldRepairReport fixedFoldRepair;
+  ::morea::FieldFoldRepairReport movingFoldRepair;
 };
 
 /** Rasterises a solution: `solution.target` is the mesh on the fixed image and
  *  `solution.source` the mesh on the moving image, both in the domain frame of
  *  the grids, which must share their direction. When the grids differ, each
  *  transform's inverse field is rasterised once more on its forward field's
- *  grid (the piecewise-affine map is extrapolated outside the mesh). */
+ *  grid (the piecewise-affine map is extrapolated outside the mesh). Every
+ *  field is then made fold-free at voxel level (::morea::RemoveVoxelFolds):
+ *  the exact map is kept except around voxels whose finite-difference
+ *  Jacobian determinant is <= 0. */
 MeshFields
 RasterizeSolution(const ::morea::MeshTopology & topology, const ::morea::DualMesh & solution,
                   const ImageBase<Dimension> * fixedGrid, const ImageBase<Dimension> * movingGrid);

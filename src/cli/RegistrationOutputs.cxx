@@ -139,6 +139,14 @@ WriteRegistrationOutputs(const itk::morea::PreprocessResult & preprocessed,
                              { "magnitude", s.fitness.objectives[0] },
                              { "intensity", s.fitness.objectives[1] },
                              { "guidance", s.fitness.objectives[2] } };
+    auto repairJson = [](const ::morea::FieldFoldRepairReport & r) {
+      return nlohmann::json{ { "folded_voxels_before", r.foldedBefore },
+                             { "folded_voxels_after", r.foldedAfter },
+                             { "voxels_smoothed", r.voxelsChanged },
+                             { "maximum_change_mm", r.maximumChange } };
+    };
+    entry["voxel_fold_repair"] = { { "fixed_to_moving", repairJson(fields.fixedFoldRepair) },
+                                   { "moving_to_fixed", repairJson(fields.movingFoldRepair) } };
     if (scored)
     {
       const auto scores = EvaluateRegistration(problem, fields.fixedToMoving, fields.movingToFixed, borderMargin);

@@ -224,11 +224,17 @@ RasterizeSolution(const ::morea::MeshTopology & topology, const ::morea::DualMes
   auto rasterize = [&](const std::vector<::morea::Vec3> & from,
                        const std::vector<::morea::Vec3> & to,
                        const ImageBase<Dimension> *       grid,
-                       ::morea::RasterizationReport *     report) {
+                       ::morea::RasterizationReport *     report,
+                       ::morea::FieldFoldRepairReport *   repair) {
     auto volume = frame.FieldGridOf(grid);
     try
     {
       ::morea::RasterizeDisplacement(topology, from, to, volume, report);
+      const ::morea::FieldFoldRepairReport repaired = ::morea::RemoveVoxelFolds(volume);
+      if (repair != nullptr)
+      {
+        *repair = repaired;
+      }
     }
     catch (const ::morea::Error & e)
     {
@@ -244,15 +250,17 @@ RasterizeSolution(const ::morea::MeshTopology & topology, const ::morea::DualMes
   };
 
   MeshFields fields;
-  fields.fixedToMoving = rasterize(solution.target, solution.source, fixedGrid, &fields.fixedReport);
-  fields.movingToFixed = rasterize(solution.source, solution.target, movingGrid, &fields.movingReport);
+  fields.fixedToMoving =
+    rasterize(solution.target, solution.source, fixedGrid, &fields.fixedReport, &fields.fixedFoldRepair);
+  fields.movingToFixed =
+    rasterize(solution.source, solution.target, movingGrid, &fields.movingReport, &fields.movingFoldRepair);
 
   // ITK wants a transform's inverse field on its forward field's grid.
   const bool                     sameGrid = SameGrid(fixedGrid, movingGrid, 1e-9);
   DisplacementFieldType::Pointer movingToFixedOnFixedGrid =
-    sameGrid ? fields.movingToFixed : rasterize(solution.source, solution.target, fixedGrid, nullptr);
+    sameGrid ? fields.movingToFixed : rasterize(solution.source, solution.target, fixedGrid, nullptr, nullptr);
   DisplacementFieldType::Pointer fixedToMovingOnMovingGrid =
-    sameGrid ? fields.fixedToMoving : rasterize(solution.target, solution.source, movingGrid, nullptr);
+    sameGrid ? fields.fixedToMoving : rasterize(solution.target, solution.source, movingGrid, nullptr, nullptr);
 
   fields.fixedToMovingTransform = DisplacementFieldTransformType::New();
   fields.fixedToMovingTransform->SetDisplacementField(fields.fixedToMoving);
