@@ -37,8 +37,35 @@ case "${1:-}" in
       --moving-structure Bowel_sm_CBCT="$D/CB07_masks/Bowel_sm_CBCT.mha" \
       --parameters bench/configurations/abdomen_paper.toml -o "$out/benchmark.json" "$@" 2>&1 | tee "$out/benchmark.log"
     ;;
+  register)
+    # The paper's configuration end to end with `morea register`, resumable:
+    # each call continues from RUNDIR/checkpoint.bin until SECONDS have passed
+    # (one device command is limited to 10 minutes), so repeated calls finish
+    # the 500 generations. RUNDIR must survive between calls (a git-ignored
+    # folder of the working tree, e.g. build-device/run500).
+    out=${2:?output folder}
+    run=${3:?run folder}
+    seconds=${4:-540}
+    backend=${5:-cuda}
+    mkdir -p "$out" "$run" /tmp/b
+    [ -x /tmp/b/bin/morea ] || tar xJf device-carry/bundle.tar.xz -C /tmp/b
+    export LD_LIBRARY_PATH=/tmp/b/lib
+    D=/tmp/b/data/abdomen
+    status=0
+    timeout --signal=KILL "$seconds" /tmp/b/bin/morea register \
+      --fixed "$D/CB02.mha" --moving "$D/CB07.mha" \
+      --fixed-structure Stomach_duo_CBCT="$D/CB02_labels.mha:Stomach_duo_CBCT" \
+      --moving-structure Stomach_duo_CBCT="$D/CB07_masks/Stomach_duo_CBCT.mha" \
+      --fixed-structure Bowel_sm_CBCT="$D/CB02_labels.mha:Bowel_sm_CBCT" \
+      --moving-structure Bowel_sm_CBCT="$D/CB07_masks/Bowel_sm_CBCT.mha" \
+      --parameters bench/configurations/abdomen_paper.toml --backend "$backend" \
+      --checkpoint-every 10 --resume -o "$run" >> "$run/register.log" 2>&1 || status=$?
+    tail -c 4000 "$run/register.log" | tee "$out/register-tail.log"
+    cp "$run"/generations.csv "$run"/summary.json "$run"/front.csv "$out/" 2>/dev/null || true
+    echo "register exit status $status (137: stopped after $seconds s; call again to resume)"
+    ;;
   *)
-    echo "usage: $0 bundle | run OUTDIR [morea benchmark options]" >&2
+    echo "usage: $0 bundle | run OUTDIR [morea benchmark options] | register OUTDIR RUNDIR [SECONDS [BACKEND]]" >&2
     exit 2
     ;;
 esac

@@ -13,6 +13,8 @@
 
 #include <cmath>
 #include <iostream>
+#include <numeric>
+#include <vector>
 
 using namespace morea;
 using morea_test::OptimiserTestProblem;
@@ -181,9 +183,12 @@ TEST(CudaEvaluationBackend, SeededRunsReachFrontsOfTheSameQuality)
 {
   MOREA_REQUIRE_CUDA_DEVICE();
   OptimiserTestProblem problem;
-  GomeaOptions         options = problem.Options(13, 16);
-  options.steeringEnabled = false; // hypervolume against the initial reference stays informative
-  auto run = [&](EvaluationBackend & backend) {
+  // Runs on the two backends start alike and drift apart (objective values
+  // differ in the last digits, so acceptance differs now and then): compare
+  // the mean over a few seeds, not one run.
+  auto run = [&](EvaluationBackend & backend, std::uint64_t seed) {
+    GomeaOptions options = problem.Options(seed, 16);
+    options.steeringEnabled = false; // hypervolume against the initial reference stays informative
     MoRvGomea optimiser(problem.base, problem.topology, problem.parallel, *problem.constraint, backend, options);
     optimiser.Initialize(problem.InitialPopulation(options));
     optimiser.Run();
@@ -202,13 +207,41 @@ TEST(CudaEvaluationBackend, SeededRunsReachFrontsOfTheSameQuality)
     }
     return optimiser.History().back();
   };
-  auto                   cpu = CreateCpuEvaluationBackend(*problem.evaluator, 2);
-  auto                   cuda = CreateCudaEvaluationBackend(*problem.evaluator, 2);
-  const GenerationRecord a = run(*cpu);
-  const GenerationRecord b = run(*cuda);
-  ASSERT_GT(a.hypervolume, 0.0);
-  EXPECT_NEAR(b.hypervolume, a.hypervolume, 0.05 * a.hypervolume);
-  EXPECT_NEAR(b.bestGuidance, a.bestGuidance, 0.25 * a.bestGuidance);
+  // Seed-to-seed spread of the final hypervolume here is about 10 % of its
+  // mean (measured on the CPU, seeds 13-28: mean 0.514, sd 0.053), so a
+  // difference of means is judged against its standard error, with 5 % as
+  // the floor of the tolerance.
+  auto                cpu = CreateCpuEvaluationBackend(*problem.evaluator, 2);
+  auto                cuda = CreateCudaEvaluationBackend(*problem.evaluator, 2);
+  std::vector<double> cpuHypervolumes, cudaHypervolumes;
+  double              cpuGuidance = 0.0, cudaGuidance = 0.0;
+  for (std::uint64_t seed = 13; seed < 25; ++seed)
+  {
+    const GenerationRecord a = run(*cpu, seed);
+    const GenerationRecord b = run(*cuda, seed);
+    ASSERT_GT(a.hypervolume, 0.0);
+    std::cout << "seed " << seed << ": hypervolume cpu " << a.hypervolume << " cuda " << b.hypervolume
+              << ", best guidance cpu " << a.bestGuidance << " cuda " << b.bestGuidance << "\n";
+    cpuHypervolumes.push_back(a.hypervolume);
+    cudaHypervolumes.push_back(b.hypervolume);
+    cpuGuidance += a.bestGuidance;
+    cudaGuidance += b.bestGuidance;
+  }
+  auto mean = [](const std::vector<double> & v) { return std::accumulate(v.begin(), v.end(), 0.0) / v.size(); };
+  auto variance = [&](const std::vector<double> & v) {
+    const double m = mean(v);
+    double       s = 0.0;
+    for (const double x : v)
+      s += (x - m) * (x - m);
+    return s / (v.size() - 1);
+  };
+  const double n = static_cast<double>(cpuHypervolumes.size());
+  const double standardError = std::sqrt((variance(cpuHypervolumes) + variance(cudaHypervolumes)) / n);
+  const double tolerance = std::max(0.05 * mean(cpuHypervolumes), 3.0 * standardError);
+  std::cout << "mean hypervolume cpu " << mean(cpuHypervolumes) << " cuda " << mean(cudaHypervolumes)
+            << ", standard error of the difference " << standardError << "\n";
+  EXPECT_NEAR(mean(cudaHypervolumes), mean(cpuHypervolumes), tolerance);
+  EXPECT_NEAR(cudaGuidance, cpuGuidance, 0.25 * cpuGuidance);
 }
 
 TEST(CudaEvaluationBackend, TextureInterpolationStaysCloseToTheCpu)
@@ -248,6 +281,7 @@ TEST(EvaluationBackendSelection, NamesAndDeviceAbsence)
 {
   EXPECT_EQ(ParseBackendChoice("cpu"), BackendChoice::Cpu);
   EXPECT_EQ(ParseBackendChoice("cuda"), BackendChoice::Cuda);
+  EXPECT_EQ(ParseBackendChoice("cuda-texture"), BackendChoice::CudaTexture);
   EXPECT_EQ(ParseBackendChoice("auto"), BackendChoice::Auto);
   EXPECT_THROW(ParseBackendChoice("gpu"), Error);
   OptimiserTestProblem problem;
@@ -267,5 +301,10 @@ TEST(EvaluationBackendSelection, NamesAndDeviceAbsence)
     {
       EXPECT_NE(std::string(e.what()).find("CUDA backend"), std::string::npos) << e.what();
     }
+    EXPECT_THROW(CreateEvaluationBackend(BackendChoice::CudaTexture, *problem.evaluator, 1), Error);
+  }
+  else
+  {
+    EXPECT_EQ(CreateEvaluationBackend(BackendChoice::CudaTexture, *problem.evaluator, 1)->Name(), "cuda-texture");
   }
 }

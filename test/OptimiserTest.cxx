@@ -124,6 +124,13 @@ TEST(MoRvGomea, SameSeedSameFrontWhateverTheThreadsOrEvaluationOrder)
   ASSERT_FALSE(a.empty());
   EXPECT_EQ(a, b);
   EXPECT_EQ(a, c);
+  // The optimiser's own host threads (sampling, fold checks) do not matter either.
+  GomeaOptions oneHostThread = options;
+  oneHostThread.threads = 1;
+  GomeaOptions fourHostThreads = options;
+  fourHostThreads.threads = 4;
+  EXPECT_EQ(a, RunToEnd(problem, *one, oneHostThread));
+  EXPECT_EQ(a, RunToEnd(problem, *three, fourHostThreads));
   const auto d = RunToEnd(problem, *one, problem.Options(22, 6));
   EXPECT_NE(a, d);
 }

@@ -28,7 +28,7 @@ public:
 
   /** Whether `f` would enter: feasible, dominated by no entry and not equal in
    *  all objectives to one, and (when discretised) not in the grid cell of an
-   *  entry it does not dominate. */
+   *  entry it does not dominate. Not for concurrent calls (see m_RejectorHint). */
   bool
   Accepts(const Fitness & f) const;
 
@@ -82,6 +82,9 @@ private:
   std::vector<ArchiveEntry> m_Entries;
   bool                      m_Discretised{ false };
   ObjectiveVector           m_CellWidths{ { 0.0, 0.0, 0.0 } };
+  /** Index of the entry that last rejected a candidate; tried first (a
+   *  speed-up only: any index gives the same answers). Not thread-safe. */
+  mutable std::size_t m_RejectorHint{ 0 };
 };
 } // namespace morea
 

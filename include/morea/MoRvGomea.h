@@ -38,6 +38,7 @@
 namespace morea
 {
 class ParameterSet;
+class ThreadPool;
 
 struct GomeaOptions
 {
@@ -52,6 +53,9 @@ struct GomeaOptions
   bool          repair{ true };
   std::size_t   fullEvaluationInterval{ 50 };
   std::uint64_t seed{ 0 };
+  /** Host threads that sample candidates and check them for folds (0: one per
+   *  hardware thread). The result does not depend on it. */
+  std::size_t threads{ 0 };
 
   /** ea_* keys, morea_repair_method and seed. */
   static GomeaOptions
@@ -74,6 +78,16 @@ struct GenerationRecord
   double      meanMultiplier{ 0.0 };    ///< over clusters and elements
   double      tetrahedronEvaluations{ 0.0 }; ///< this generation
   double      seconds{ 0.0 };           ///< wall time of this generation
+  /** Where the generation's wall time went (host timers; evaluation is the
+   *  backend's calls, incl. transfers and waiting for the GPU). */
+  struct Phases
+  {
+    double sampling{ 0.0 };
+    double foldChecks{ 0.0 }; ///< incl. repair
+    double evaluation{ 0.0 };
+    double acceptance{ 0.0 };
+    double forcedImprovements{ 0.0 }; ///< all of it, its own phases included
+  } phaseSeconds;
 };
 
 /** Per cluster and FOS element: what carries over between generations. */
@@ -159,6 +173,12 @@ private:
   struct ClusterModel;
   struct Candidate;
 
+  /** Draws each candidate's variables (its solution, element, cluster and
+   *  seed are set) from `cluster`'s distribution for its element, in
+   *  parallel: each candidate has its own random stream. */
+  void
+  SampleCandidates(std::vector<Candidate> & candidates, const ClusterModel & cluster);
+
   Fitness
   Steered(const Fitness & raw) const;
   Fitness
@@ -190,6 +210,7 @@ private:
   const FoldConstraint &    m_Constraint;
   EvaluationBackend &       m_Backend;
   GomeaOptions              m_Options;
+  std::unique_ptr<ThreadPool> m_Pool; ///< candidate sampling and fold checks
 
   std::size_t                             m_Generation{ 0 };
   std::vector<DualMesh>                   m_Population;

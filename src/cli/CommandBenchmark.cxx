@@ -44,9 +44,7 @@ TimeBackend(const std::string & name, const itk::morea::MeshModel & model, const
 {
   const std::size_t memoryBefore = CudaMemoryInUse();
   std::size_t       memoryPeak = memoryBefore;
-  auto              backend = name == "cuda-texture"
-                                ? CreateCudaEvaluationBackend(evaluator, threads, CudaInterpolation::Texture)
-                                : CreateEvaluationBackend(ParseBackendChoice(name), evaluator, threads);
+  auto              backend = CreateEvaluationBackend(ParseBackendChoice(name), evaluator, threads);
   std::cout << "  backend " << backend->Name() << ": initial population of " << gomea.populationSize << "\n"
             << std::flush;
   auto                 start = Clock::now();
@@ -80,10 +78,22 @@ TimeBackend(const std::string & name, const itk::morea::MeshModel & model, const
                               { "batches", after.batches - before.batches },
                               { "best_guidance", r.bestGuidance },
                               { "hypervolume", r.hypervolume },
-                              { "archive", r.archiveSize } });
+                              { "archive", r.archiveSize },
+                              { "candidates", r.candidates },
+                              { "folded", r.folded },
+                              { "repaired", r.repaired },
+                              { "forced_improvements", r.forcedImprovements },
+                              { "phase_seconds",
+                                { { "sampling", r.phaseSeconds.sampling },
+                                  { "fold_checks_and_repair", r.phaseSeconds.foldChecks },
+                                  { "evaluation", r.phaseSeconds.evaluation },
+                                  { "acceptance", r.phaseSeconds.acceptance },
+                                  { "forced_improvements", r.phaseSeconds.forcedImprovements } } } });
     std::cout << "    generation " << r.generation << ": " << std::fixed << std::setprecision(3) << seconds
               << " s (backend " << after.seconds - before.seconds << " s, kernels "
-              << after.kernelSeconds - before.kernelSeconds << " s), best guidance " << std::defaultfloat
+              << after.kernelSeconds - before.kernelSeconds << " s; sampling " << r.phaseSeconds.sampling
+              << ", folds " << r.phaseSeconds.foldChecks << ", acceptance " << r.phaseSeconds.acceptance
+              << ", forced " << r.phaseSeconds.forcedImprovements << "), best guidance " << std::defaultfloat
               << r.bestGuidance << "\n"
               << std::flush;
   }

@@ -44,8 +44,10 @@ AddRegisterCommand(CLI::App & app)
     ->capture_default_str();
   cmd->add_flag("--resume", options->resume, "continue from output/checkpoint.bin when it exists");
   cmd->add_option("--threads", options->threads, "CPU threads (0: all)")->capture_default_str();
-  cmd->add_option("--backend", options->backend, "evaluation backend: cpu, cuda, or auto (CUDA when a device is present)")
-    ->check(CLI::IsMember({ "cpu", "cuda", "auto" }))
+  cmd->add_option("--backend", options->backend,
+                  "evaluation backend: cpu, cuda, cuda-texture (hardware interpolation, faster), or auto (cuda when "
+                  "a device is present)")
+    ->check(CLI::IsMember({ "cpu", "cuda", "cuda-texture", "auto" }))
     ->capture_default_str();
   // For crash-recovery tests: the process kills itself (SIGKILL) right after
   // generation N, as an external kill would, leaving only the checkpoint.

@@ -119,14 +119,23 @@ ElitistArchive::Accepts(const Fitness & f) const
   if (!f.feasible || !AllFinite(f.objectives))
     return false;
   const Cell cell = m_Discretised ? CellOf(f.objectives, m_CellWidths) : Cell{};
-  for (const ArchiveEntry & e : m_Entries)
-  {
+  auto       rejects = [&](const ArchiveEntry & e) {
     const ObjectiveVector & y = e.fitness.objectives;
     if (y == f.objectives || Dominates(y, f.objectives))
+      return true;
+    return m_Discretised && CellOf(y, m_CellWidths) == cell && !Dominates(f.objectives, y);
+  };
+  // The optimiser asks about many near-copies of one solution in a row, and
+  // the entry that turned one away usually turns away the next: trying it
+  // first saves the scan without changing the answer.
+  if (m_RejectorHint < m_Entries.size() && rejects(m_Entries[m_RejectorHint]))
+    return false;
+  for (std::size_t i = 0; i < m_Entries.size(); ++i)
+    if (rejects(m_Entries[i]))
+    {
+      m_RejectorHint = i;
       return false;
-    if (m_Discretised && CellOf(y, m_CellWidths) == cell && !Dominates(f.objectives, y))
-      return false;
-  }
+    }
   return true;
 }
 

@@ -3,6 +3,7 @@
 #include "morea/Error.h"
 #include "morea/MeshRepair.h"
 #include "morea/ParameterSet.h"
+#include "morea/ThreadPool.h"
 
 #include <algorithm>
 #include <chrono>
@@ -26,6 +27,14 @@ constexpr std::size_t KMeansIterations = 3;
 constexpr std::size_t NoImprovementStretchBase = 25;
 // A steering violation must rank before any fold: folds are the hard constraint.
 constexpr double FoldConstraintOffset = 1.0e12;
+double
+SecondsSince(std::chrono::steady_clock::time_point start)
+{
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// Random streams derived from a candidate's seed (the repair uses 0 and 1: the side).
+constexpr std::uint64_t SamplingStream = 2;
 
 double
 Normalised(double v, double low, double high)
@@ -152,7 +161,8 @@ struct MoRvGomea::Candidate
   std::size_t                    element{ 0 };
   int                            singleObjective{ -1 }; ///< acceptance rule: -1 Pareto, else that objective
   bool                           forced{ false };       ///< forced improvement: must dominate the parent
-  std::uint64_t                  seed{ 0 };             ///< for the repair
+  std::uint64_t                  seed{ 0 };             ///< of its sampling and repair streams
+  bool                           anticipate{ false };   ///< add the anticipated mean shift
   std::vector<Vec3>              source, target;
   std::vector<TetrahedronValues> values;
   std::vector<double>            sample; ///< the drawn variables (before projection), for the ratio test
@@ -180,6 +190,7 @@ MoRvGomea::MoRvGomea(const TetrahedralMesh & base, const MeshTopology & topology
   if (parallel.elements.empty())
     throw Error("optimiser: the mesh has no FOS elements");
   m_Archive = std::make_unique<ElitistArchive>(options.archiveCapacity);
+  m_Pool = std::make_unique<ThreadPool>(options.threads);
 }
 
 MoRvGomea::~MoRvGomea() = default;
@@ -566,27 +577,62 @@ MoRvGomea::EstimateDistributions(std::vector<ClusterModel> & clusters) const
   }
 }
 
+void
+MoRvGomea::SampleCandidates(std::vector<Candidate> & candidates, const ClusterModel & cluster)
+{
+  m_Pool->ParallelFor(candidates.size(), [&](std::size_t i) {
+    Candidate &                 cand = candidates[i];
+    const FosElement &          element = m_Parallel.elements[cand.element];
+    const std::size_t           dim = 6 * element.points.size();
+    const std::vector<double> & mean = cluster.means[cand.element];
+    const std::vector<double> & l = cluster.cholesky[cand.element];
+    const DistributionState &   state = m_Distributions[cand.cluster][cand.element];
+    RandomGenerator             random(HashCombine(cand.seed, SamplingStream));
+    std::vector<double>         z(dim);
+    std::vector<double> &       x = cand.sample;
+    x.resize(dim);
+    for (auto & v : z)
+      v = random.Normal();
+    const double scale = std::sqrt(state.multiplier);
+    for (std::size_t a = 0; a < dim; ++a)
+    {
+      double v = 0.0;
+      for (std::size_t b = 0; b <= a; ++b)
+        v += l[a * dim + b] * z[b];
+      x[a] = mean[a] + scale * v;
+    }
+    if (cand.anticipate && state.previousMean.size() == dim)
+      for (std::size_t a = 0; a < dim; ++a)
+        x[a] += AmsDelta * state.multiplier * (mean[a] - state.previousMean[a]);
+    cand.source.resize(element.points.size());
+    cand.target.resize(element.points.size());
+    for (std::size_t k = 0; k < element.points.size(); ++k)
+    {
+      const std::uint32_t p = element.points[k];
+      cand.source[k] = ProjectToDomain({ { x[6 * k], x[6 * k + 1], x[6 * k + 2] } }, m_Base.pins[p], m_Base.domain);
+      cand.target[k] =
+        ProjectToDomain({ { x[6 * k + 3], x[6 * k + 4], x[6 * k + 5] } }, m_Base.pins[p], m_Base.domain);
+    }
+  });
+}
+
 std::size_t
 MoRvGomea::ProcessCandidates(std::vector<Candidate> & candidates, GenerationRecord & record)
 {
   const auto &   tets = m_Topology.Tetrahedra();
   RepairOptions  repairOptions;
   // 1. Folds: checked (and repaired) before any costly evaluation; a folded
-  //    candidate cannot replace a fold-free parent.
-  std::vector<PartialCandidate> batch;
-  std::vector<std::size_t>      batchIndex;
-  std::vector<Vec3>             scratch;
-  for (std::size_t i = 0; i < candidates.size(); ++i)
-  {
+  //    candidate cannot replace a fold-free parent. Candidates are
+  //    independent here (each repair has its own random stream), so they are
+  //    checked in parallel and gathered in order afterwards.
+  auto                      phaseStart = std::chrono::steady_clock::now();
+  std::vector<std::uint8_t> foldedSides(candidates.size(), 0);
+  std::vector<std::uint8_t> repairedSides(candidates.size(), 0);
+  m_Pool->ParallelFor(candidates.size(), [&](std::size_t i) {
     Candidate &        c = candidates[i];
     const FosElement & element = m_Parallel.elements[c.element];
     const DualMesh &   parent = m_Population[c.solution];
-    ++record.candidates;
-    PartialCandidate p;
-    p.parent = &parent;
-    p.element = &element;
-    p.source = c.source.data(); // stays valid: the repair below assigns in place
-    p.target = c.target.data();
+    std::vector<Vec3>  scratch;
     for (int side = 0; side < 2; ++side)
     {
       const std::vector<Vec3> & from = side == 0 ? parent.source : parent.target;
@@ -594,15 +640,19 @@ MoRvGomea::ProcessCandidates(std::vector<Candidate> & candidates, GenerationReco
       bool                      folded = false;
       for (std::uint32_t t : element.dependentTetrahedra)
       {
-        Corners source, target;
-        CandidateCorners(p, tets[t], source, target);
-        const Corners & corners = side == 0 ? source : target;
+        Corners corners;
+        for (int v = 0; v < 4; ++v)
+        {
+          const std::uint32_t q = tets[t][v];
+          const auto          it = std::find(element.points.begin(), element.points.end(), q);
+          corners[v] = it == element.points.end() ? from[q] : moved[static_cast<std::size_t>(it - element.points.begin())];
+        }
         m_Constraint.TetrahedronViolation(t, corners[0], corners[1], corners[2], corners[3], folded);
         if (folded)
           break;
       }
       if (folded && !c.folded)
-        ++record.folded;
+        foldedSides[i] += 1;
       if (folded && m_Options.repair)
       {
         scratch = from;
@@ -615,12 +665,28 @@ MoRvGomea::ProcessCandidates(std::vector<Candidate> & candidates, GenerationReco
           moved[k] = scratch[element.points[k]];
         folded = !r.after.Feasible();
         if (!folded)
-          ++record.repaired;
+          repairedSides[i] += 1;
       }
       c.folded = c.folded || folded;
     }
+  });
+
+  std::vector<PartialCandidate> batch;
+  std::vector<std::size_t>      batchIndex;
+  for (std::size_t i = 0; i < candidates.size(); ++i)
+  {
+    Candidate &        c = candidates[i];
+    const FosElement & element = m_Parallel.elements[c.element];
+    ++record.candidates;
+    record.folded += foldedSides[i];
+    record.repaired += repairedSides[i];
     if (c.folded && std::llround(m_Totals[c.solution].sum.folded) == 0)
       continue;
+    PartialCandidate p;
+    p.parent = &m_Population[c.solution];
+    p.element = &element;
+    p.source = c.source.data();
+    p.target = c.target.data();
     c.values.resize(element.dependentTetrahedra.size());
     p.values = c.values.data();
     batch.push_back(p);
@@ -628,8 +694,13 @@ MoRvGomea::ProcessCandidates(std::vector<Candidate> & candidates, GenerationReco
     record.tetrahedronEvaluations += static_cast<double>(element.dependentTetrahedra.size());
   }
 
+  record.phaseSeconds.foldChecks += SecondsSince(phaseStart);
+
   // 2. Evaluation of the whole batch at once (the backend's unit of work).
+  phaseStart = std::chrono::steady_clock::now();
   m_Backend.EvaluatePartials(batch);
+  record.phaseSeconds.evaluation += SecondsSince(phaseStart);
+  phaseStart = std::chrono::steady_clock::now();
 
   // 3. Acceptance in a fixed order; candidates of one solution touch disjoint
   //    tetrahedra, so each sees the totals left by the ones before it.
@@ -679,6 +750,7 @@ MoRvGomea::ProcessCandidates(std::vector<Candidate> & candidates, GenerationReco
     ++accepted;
   }
   record.accepted += accepted;
+  record.phaseSeconds.acceptance += SecondsSince(phaseStart);
   return accepted;
 }
 
@@ -786,45 +858,22 @@ MoRvGomea::RunGeneration()
     for (std::size_t g : groupOrder)
     {
       std::vector<Candidate> candidates;
+      candidates.reserve(members.size() * m_Parallel.groups[g].size());
       for (std::size_t j = 0; j < members.size(); ++j)
         for (std::uint32_t e : m_Parallel.groups[g])
         {
-          const FosElement &        element = m_Parallel.elements[e];
-          const std::size_t         dim = 6 * element.points.size();
-          const std::vector<double> & mean = cluster.means[e];
-          const std::vector<double> & l = cluster.cholesky[e];
-          const DistributionState &   state = m_Distributions[c][e];
-          std::vector<double>         z(dim), x(dim);
-          for (auto & v : z)
-            v = random.Normal();
-          const double scale = std::sqrt(state.multiplier);
-          for (std::size_t a = 0; a < dim; ++a)
-          {
-            double v = 0.0;
-            for (std::size_t b = 0; b <= a; ++b)
-              v += l[a * dim + b] * z[b];
-            x[a] = mean[a] + scale * v;
-          }
-          if (j < amsCount && state.previousMean.size() == dim)
-            for (std::size_t a = 0; a < dim; ++a)
-              x[a] += AmsDelta * state.multiplier * (mean[a] - state.previousMean[a]);
           Candidate cand;
           cand.solution = members[j];
           cand.element = e;
           cand.cluster = c;
           cand.singleObjective = cluster.singleObjective;
           cand.seed = random.NextU64();
-          for (std::size_t k = 0; k < element.points.size(); ++k)
-          {
-            const std::uint32_t p = element.points[k];
-            cand.source.push_back(
-              ProjectToDomain({ { x[6 * k], x[6 * k + 1], x[6 * k + 2] } }, m_Base.pins[p], m_Base.domain));
-            cand.target.push_back(
-              ProjectToDomain({ { x[6 * k + 3], x[6 * k + 4], x[6 * k + 5] } }, m_Base.pins[p], m_Base.domain));
-          }
-          cand.sample = std::move(x);
+          cand.anticipate = j < amsCount;
           candidates.push_back(std::move(cand));
         }
+      const auto sampling = std::chrono::steady_clock::now();
+      SampleCandidates(candidates, cluster);
+      record.phaseSeconds.sampling += SecondsSince(sampling);
       ProcessCandidates(candidates, record);
       for (const Candidate & cand : candidates)
         if (cand.accepted)
@@ -892,7 +941,9 @@ MoRvGomea::RunGeneration()
     m_NoImprovement[s] = improved[s] ? 0 : m_NoImprovement[s] + 1;
     if (m_NoImprovement[s] > maxStretch)
     {
+      const auto forced = std::chrono::steady_clock::now();
       ForcedImprovement(s, solutionCluster[s], random, record);
+      record.phaseSeconds.forcedImprovements += SecondsSince(forced);
       m_NoImprovement[s] = 0;
     }
   }

@@ -12,9 +12,11 @@ ParseBackendChoice(const std::string & name)
     return BackendChoice::Cpu;
   if (name == "cuda")
     return BackendChoice::Cuda;
+  if (name == "cuda-texture")
+    return BackendChoice::CudaTexture;
   if (name == "auto")
     return BackendChoice::Auto;
-  throw Error("unknown backend '" + name + "' (choose cpu, cuda or auto)");
+  throw Error("unknown backend '" + name + "' (choose cpu, cuda, cuda-texture or auto)");
 }
 
 std::unique_ptr<EvaluationBackend>
@@ -26,6 +28,8 @@ CreateEvaluationBackend(BackendChoice choice, const TetrahedronEvaluator & evalu
       return CreateCpuEvaluationBackend(evaluator, threads);
     case BackendChoice::Cuda:
       return CreateCudaEvaluationBackend(evaluator, threads);
+    case BackendChoice::CudaTexture:
+      return CreateCudaEvaluationBackend(evaluator, threads, CudaInterpolation::Texture);
     case BackendChoice::Auto:
       break;
   }
