@@ -56,6 +56,22 @@ ExpectSameTotals(const std::vector<TetrahedronValues> & cpu, const std::vector<T
     ExpectRelativelyClose(fa.objectives[m], fb.objectives[m], 1e-4, what + " objective " + std::to_string(m), floor);
   EXPECT_EQ(fa.feasible, fb.feasible);
 }
+
+/** Per-tetrahedron values of every solution of `population` from `backend`. */
+std::vector<std::vector<TetrahedronValues>>
+EvaluateAll(EvaluationBackend & backend, const std::vector<DualMesh> & population)
+{
+  std::vector<const DualMesh *>                 solutions;
+  std::vector<std::vector<TetrahedronValues>>   values(population.size());
+  std::vector<std::vector<TetrahedronValues> *> outputs;
+  for (std::size_t i = 0; i < population.size(); ++i)
+  {
+    solutions.push_back(&population[i]);
+    outputs.push_back(&values[i]);
+  }
+  backend.EvaluateSolutions(solutions, outputs);
+  return values;
+}
 } // namespace
 
 TEST(CudaEvaluationBackend, WholeSolutionsAgreeWithTheCpu)
@@ -75,17 +91,8 @@ TEST(CudaEvaluationBackend, WholeSolutionsAgreeWithTheCpu)
     auto cpu = CreateCpuEvaluationBackend(*problem.evaluator, 2);
     auto cuda = CreateCudaEvaluationBackend(*problem.evaluator, 2);
     EXPECT_EQ(cuda->Name(), "cuda");
-    std::vector<const DualMesh *>                solutions;
-    std::vector<std::vector<TetrahedronValues>> a(population.size()), b(population.size());
-    std::vector<std::vector<TetrahedronValues> *> pa, pb;
-    for (std::size_t i = 0; i < population.size(); ++i)
-    {
-      solutions.push_back(&population[i]);
-      pa.push_back(&a[i]);
-      pb.push_back(&b[i]);
-    }
-    cpu->EvaluateSolutions(solutions, pa);
-    cuda->EvaluateSolutions(solutions, pb);
+    const auto a = EvaluateAll(*cpu, population);
+    const auto b = EvaluateAll(*cuda, population);
     for (std::size_t i = 0; i < population.size(); ++i)
       ExpectSameTotals(a[i], b[i], "rate " + std::to_string(rate) + " solution " + std::to_string(i));
     double folds = 0.0;
@@ -158,17 +165,8 @@ TEST(CudaEvaluationBackend, VolumeBoundFoldsAgreeWithTheCpu)
   GomeaOptions               options = problem.Options(8);
   options.populationSize = 5;
   const auto population = problem.InitialPopulation(options);
-  std::vector<const DualMesh *>                solutions;
-  std::vector<std::vector<TetrahedronValues>> a(population.size()), b(population.size());
-  std::vector<std::vector<TetrahedronValues> *> pa, pb;
-  for (std::size_t i = 0; i < population.size(); ++i)
-  {
-    solutions.push_back(&population[i]);
-    pa.push_back(&a[i]);
-    pb.push_back(&b[i]);
-  }
-  CreateCpuEvaluationBackend(evaluator, 2)->EvaluateSolutions(solutions, pa);
-  CreateCudaEvaluationBackend(evaluator, 2)->EvaluateSolutions(solutions, pb);
+  const auto a = EvaluateAll(*CreateCpuEvaluationBackend(evaluator, 2), population);
+  const auto b = EvaluateAll(*CreateCudaEvaluationBackend(evaluator, 2), population);
   double folds = 0.0;
   for (std::size_t i = 0; i < population.size(); ++i)
   {

@@ -101,6 +101,12 @@ ParseBackendChoice(const std::string & name);
 std::unique_ptr<EvaluationBackend>
 CreateEvaluationBackend(BackendChoice choice, const TetrahedronEvaluator & evaluator, std::size_t threads = 0);
 
+/** Corners of tetrahedron `t` on one side of a mesh whose points `moved` are
+ *  replaced by `replacements` (one per moved point, in the same order). */
+Corners
+CornersWithReplacedPoints(const Tetrahedron & t, const std::vector<Vec3> & points,
+                          const std::vector<std::uint32_t> & moved, const Vec3 * replacements);
+
 /** Corners of tetrahedron `t` in a parent whose element points are replaced. */
 void
 CandidateCorners(const PartialCandidate & candidate, const Tetrahedron & t, Corners & source, Corners & target);

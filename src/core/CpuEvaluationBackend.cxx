@@ -11,25 +11,24 @@
 
 namespace morea
 {
-void
-CandidateCorners(const PartialCandidate & c, const Tetrahedron & t, Corners & source, Corners & target)
+Corners
+CornersWithReplacedPoints(const Tetrahedron & t, const std::vector<Vec3> & points,
+                          const std::vector<std::uint32_t> & moved, const Vec3 * replacements)
 {
-  const auto & moved = c.element->points;
+  Corners corners;
   for (int i = 0; i < 4; ++i)
   {
     const auto it = std::find(moved.begin(), moved.end(), t[i]);
-    if (it == moved.end())
-    {
-      source[i] = c.parent->source[t[i]];
-      target[i] = c.parent->target[t[i]];
-    }
-    else
-    {
-      const auto k = static_cast<std::size_t>(it - moved.begin());
-      source[i] = c.source[k];
-      target[i] = c.target[k];
-    }
+    corners[i] = it == moved.end() ? points[t[i]] : replacements[static_cast<std::size_t>(it - moved.begin())];
   }
+  return corners;
+}
+
+void
+CandidateCorners(const PartialCandidate & c, const Tetrahedron & t, Corners & source, Corners & target)
+{
+  source = CornersWithReplacedPoints(t, c.parent->source, c.element->points, c.source);
+  target = CornersWithReplacedPoints(t, c.parent->target, c.element->points, c.target);
 }
 
 namespace

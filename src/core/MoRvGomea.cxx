@@ -640,13 +640,7 @@ MoRvGomea::ProcessCandidates(std::vector<Candidate> & candidates, GenerationReco
       bool                      folded = false;
       for (std::uint32_t t : element.dependentTetrahedra)
       {
-        Corners corners;
-        for (int v = 0; v < 4; ++v)
-        {
-          const std::uint32_t q = tets[t][v];
-          const auto          it = std::find(element.points.begin(), element.points.end(), q);
-          corners[v] = it == element.points.end() ? from[q] : moved[static_cast<std::size_t>(it - element.points.begin())];
-        }
+        const Corners corners = CornersWithReplacedPoints(tets[t], from, element.points, moved.data());
         m_Constraint.TetrahedronViolation(t, corners[0], corners[1], corners[2], corners[3], folded);
         if (folded)
           break;
