@@ -151,9 +151,52 @@ TEST(CudaEvaluationBackend, PartialCandidatesAgreeWithTheCpu)
     return batch;
   };
   CreateCpuEvaluationBackend(*problem.evaluator, 2)->EvaluatePartials(withValues(a));
-  CreateCudaEvaluationBackend(*problem.evaluator, 2)->EvaluatePartials(withValues(b));
+  auto cuda = CreateCudaEvaluationBackend(*problem.evaluator, 2);
+  cuda->EvaluatePartials(withValues(b));
   for (std::size_t i = 0; i < candidates.size(); ++i)
     ExpectSameTotals(a[i], b[i], "candidate " + std::to_string(i), 1e-6); // a few tetrahedra: sums can be ~0
+
+  // A second batch on the same backend, in reverse order and without the
+  // first solution's candidates: the device builds the corners from another
+  // parent and element layout and must give the same values.
+  std::vector<PartialCandidate>               reversed(candidates.rbegin(), candidates.rend() - group.size());
+  std::vector<std::vector<TetrahedronValues>> r(reversed.size());
+  for (std::size_t i = 0; i < reversed.size(); ++i)
+  {
+    r[i].resize(reversed[i].element->dependentTetrahedra.size());
+    reversed[i].values = r[i].data();
+  }
+  cuda->EvaluatePartials(reversed);
+  for (std::size_t i = 0; i < reversed.size(); ++i)
+  {
+    const std::size_t original = candidates.size() - 1 - i;
+    ASSERT_EQ(r[i].size(), b[original].size());
+    for (std::size_t t = 0; t < r[i].size(); ++t)
+    {
+      EXPECT_EQ(r[i][t].intensity, b[original][t].intensity) << "candidate " << original;
+      EXPECT_EQ(r[i][t].magnitude, b[original][t].magnitude) << "candidate " << original;
+    }
+  }
+
+  // The texture path: same samples and per-tetrahedron constraint values;
+  // objectives close over the whole batch (hardware interpolation weights
+  // and single precision make a few tetrahedra's near-zero sums noisy).
+  std::vector<std::vector<TetrahedronValues>> c(candidates.size());
+  CreateCudaEvaluationBackend(*problem.evaluator, 2, CudaInterpolation::Texture)->EvaluatePartials(withValues(c));
+  ObjectiveTotals ta, tc;
+  std::size_t     count = 0;
+  for (std::size_t i = 0; i < candidates.size(); ++i)
+    for (std::size_t t = 0; t < a[i].size(); ++t, ++count)
+    {
+      EXPECT_EQ(a[i][t].samples, c[i][t].samples);
+      EXPECT_EQ(a[i][t].folded, c[i][t].folded);
+      ExpectRelativelyClose(a[i][t].magnitude, c[i][t].magnitude, 1e-9, "texture magnitude");
+      ta.Add(a[i][t]);
+      tc.Add(c[i][t]);
+    }
+  const Fitness fa = ta.ToFitness(count), fc = tc.ToFitness(count);
+  for (std::size_t m = 0; m < NumberOfObjectives; ++m)
+    ExpectRelativelyClose(fa.objectives[m], fc.objectives[m], 1e-2, "texture objective " + std::to_string(m));
 }
 
 TEST(CudaEvaluationBackend, VolumeBoundFoldsAgreeWithTheCpu)

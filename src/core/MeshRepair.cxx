@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace morea
 {
@@ -38,6 +39,25 @@ bool
 Better(const FoldViolation & a, const FoldViolation & b)
 {
   return a.value < b.value || (a.value <= b.value && a.folded < b.folded);
+}
+
+/** The violation of tetrahedra [first, last) (FoldConstraint::Partial's sum,
+ *  in its order), or false as soon as the running value exceeds `bound`:
+ *  violations are non-negative, so such a trial cannot be Better. */
+bool
+BoundedViolation(const FoldConstraint & constraint, const std::vector<Vec3> & points, const std::uint32_t * first,
+                 const std::uint32_t * last, double bound, FoldViolation & out)
+{
+  out = FoldViolation{};
+  for (const std::uint32_t * t = first; t != last; ++t)
+  {
+    bool folded = false;
+    out.value += constraint.TetrahedronViolation(*t, points, folded);
+    out.folded += folded;
+    if (out.value > bound)
+      return false;
+  }
+  return true;
 }
 } // namespace
 
@@ -92,8 +112,10 @@ RepairPoints(std::vector<Vec3> & points, const std::vector<std::uint32_t> * mova
       const BoundaryPin & pin = base.pins[p];
       if (pin[0] != 0 && pin[1] != 0 && pin[2] != 0)
         continue; // corners never move
-      const std::vector<std::uint32_t> local = topology.TetrahedraOfPoint(p);
-      const FoldViolation              current = constraint.Partial(points, local);
+      const std::uint32_t * localBegin = topology.TetrahedraOfPointBegin(p);
+      const std::uint32_t * localEnd = topology.TetrahedraOfPointEnd(p);
+      FoldViolation         current;
+      BoundedViolation(constraint, points, localBegin, localEnd, std::numeric_limits<double>::infinity(), current);
       if (current.Feasible())
         continue; // fixed by an earlier move in this pass
       const double scale = DistanceToSurroundingPolyhedron(p, points, topology);
@@ -107,8 +129,8 @@ RepairPoints(std::vector<Vec3> & points, const std::vector<std::uint32_t> * mova
         const Vec3 trial{ { original[0] + scale * random.Normal(), original[1] + scale * random.Normal(),
                             original[2] + scale * random.Normal() } };
         points[p] = ProjectToDomain(trial, pin, base.domain);
-        const FoldViolation v = constraint.Partial(points, local);
-        if (Better(v, best))
+        FoldViolation v;
+        if (BoundedViolation(constraint, points, localBegin, localEnd, best.value, v) && Better(v, best))
         {
           best = v;
           bestPosition = points[p];

@@ -697,19 +697,31 @@ MoRvGomea::ProcessCandidates(std::vector<Candidate> & candidates, GenerationReco
   phaseStart = std::chrono::steady_clock::now();
 
   // 3. Acceptance in a fixed order; candidates of one solution touch disjoint
-  //    tetrahedra, so each sees the totals left by the ones before it.
+  //    tetrahedra, so each one's change of the totals does not depend on the
+  //    others and is summed in parallel first (reading the stored values is
+  //    bound by memory latency); each then sees the totals left by the ones
+  //    before it.
+  std::vector<TetrahedronValues> changes(batchIndex.size());
+  m_Pool->ParallelFor(batchIndex.size(), [&](std::size_t b) {
+    const Candidate &  c = candidates[batchIndex[b]];
+    const FosElement & element = m_Parallel.elements[c.element];
+    const auto &       stored = m_TetValues[c.solution];
+    ObjectiveTotals    change;
+    for (std::size_t k = 0; k < element.dependentTetrahedra.size(); ++k)
+    {
+      change.Add(stored[element.dependentTetrahedra[k]], -1.0);
+      change.Add(c.values[k]);
+    }
+    changes[b] = change.sum;
+  });
   std::size_t accepted = 0;
-  for (std::size_t i : batchIndex)
+  for (std::size_t b = 0; b < batchIndex.size(); ++b)
   {
-    Candidate &        c = candidates[i];
+    Candidate &        c = candidates[batchIndex[b]];
     const FosElement & element = m_Parallel.elements[c.element];
     const std::size_t  s = c.solution;
     ObjectiveTotals    totals = m_Totals[s];
-    for (std::size_t k = 0; k < element.dependentTetrahedra.size(); ++k)
-    {
-      totals.Add(m_TetValues[s][element.dependentTetrahedra[k]], -1.0);
-      totals.Add(c.values[k]);
-    }
+    totals.Add(changes[b]);
     const Fitness now = CurrentFitness(s);
     const Fitness next = Steered(totals.ToFitness(m_Topology.NumberOfTetrahedra()));
     bool          accept = false;

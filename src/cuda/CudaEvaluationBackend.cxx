@@ -1,9 +1,10 @@
 // The CUDA evaluation backend: the same calls as the CPU backend
-// (CpuEvaluationBackend.cxx), evaluated on the GPU. Images, distance maps
-// and per-tetrahedron constants are uploaded once; each call packs the
-// corners of every tetrahedron to evaluate, runs one kernel over all of them
-// (all candidates of a parallel group of a cluster at once) and copies the
-// values back: one host-device synchronisation per call.
+// (CpuEvaluationBackend.cxx), evaluated on the GPU. Images, distance maps,
+// the mesh and per-tetrahedron constants are uploaded once. A batch of
+// partial candidates (all candidates of a parallel group of a cluster) goes
+// up as its parents' points, its elements and the moved points; the device
+// builds every dependent tetrahedron's corners, evaluates all of them at once
+// and the values come back: one host-device synchronisation per call.
 #include "morea/EvaluationBackend.h"
 
 #include "DeviceMemory.h"
@@ -15,14 +16,22 @@
 #include "morea/ThreadPool.h"
 
 #include <algorithm>
-#include <vector>
 #include <chrono>
+#include <cmath>
+#include <unordered_map>
+#include <vector>
 
 namespace morea
 {
 namespace
 {
 using cuda::Check;
+
+/** The texture path's textures of one image. */
+struct VolumeTextures
+{
+  std::unique_ptr<cuda::Texture3D> intensity, distance;
+};
 
 class CudaEvaluationBackend final : public EvaluationBackend
 {
@@ -38,11 +47,14 @@ public:
     m_Stream = std::make_unique<cuda::Stream>();
     m_KernelStart = std::make_unique<cuda::Event>();
     m_KernelEnd = std::make_unique<cuda::Event>();
+    m_HostChunks.Reserve(1);
     cuda::UploadSobolDirections(SobolDirectionNumbers());
 
     const ObjectiveData & data = evaluator.Data();
     m_Constants.structures = static_cast<int>(data.NumberOfGuidanceStructures());
     m_Constants.guidanceWeights = Upload(data.guidanceWeights, m_GuidanceWeights);
+    for (std::size_t g = 0; g < std::min<std::size_t>(3, data.guidanceWeights.size()); ++g)
+      m_Constants.textureGuidanceWeights[g] = static_cast<float>(data.guidanceWeights[g]);
     m_Constants.guidanceRadius = data.guidanceRadius;
     m_Constants.samplingRate = data.samplingRate;
     m_Constants.voxelVolume = data.voxelVolume;
@@ -55,14 +67,19 @@ public:
       m_Constants.packed = true;
       m_Constants.interpolation =
         interpolation == CudaInterpolation::Texture ? cuda::Interpolation::Texture : cuda::Interpolation::Exact;
-      m_Constants.packedMoving = UploadPacked(data.moving, m_PackedMoving, m_MovingTexture, interpolation);
-      m_Constants.packedFixed = UploadPacked(data.fixed, m_PackedFixed, m_FixedTexture, interpolation);
+      m_Constants.packedMoving = UploadPacked(data.moving, m_PackedMoving, m_MovingTextures, interpolation);
+      m_Constants.packedFixed = UploadPacked(data.fixed, m_PackedFixed, m_FixedTextures, interpolation);
     }
     else
     {
       m_Constants.moving = Upload(data.moving, m_Moving);
       m_Constants.fixed = Upload(data.fixed, m_Fixed);
     }
+    std::vector<std::uint32_t> mesh;
+    for (const Tetrahedron & t : evaluator.Topology().Tetrahedra())
+      mesh.insert(mesh.end(), t.begin(), t.end());
+    m_Batch.tetrahedra = Upload(mesh, m_Mesh);
+    m_Batch.points = static_cast<std::uint32_t>(evaluator.Topology().NumberOfPoints());
     Check(cudaStreamSynchronize(m_Stream->Get()), "uploading the images");
   }
 
@@ -91,40 +108,32 @@ public:
         Pack(s * n + t, static_cast<std::uint32_t>(t), CornersOf(tets[t], solutions[s]->source),
              CornersOf(tets[t], solutions[s]->target));
     });
+    CopyCornersToDevice(solutions.size() * n);
     Run(solutions.size() * n);
-    m_Pool.ParallelFor(solutions.size(), [&](std::size_t s) {
-      values[s]->resize(n);
-      for (std::size_t t = 0; t < n; ++t)
-        (*values[s])[t] = Unpack(s * n + t);
-    });
+    std::vector<std::size_t> first(solutions.size() + 1);
+    for (std::size_t s = 0; s <= solutions.size(); ++s)
+      first[s] = s * n;
+    for (auto * v : values)
+      v->resize(n);
+    UnpackAll(first, [&](std::size_t s) { return values[s]->data(); });
     m_Statistics.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
 
   void
   EvaluatePartials(const std::vector<PartialCandidate> & candidates) override
   {
-    const auto               start = std::chrono::steady_clock::now();
-    const auto &             tets = m_Evaluator.Topology().Tetrahedra();
+    const auto  start = std::chrono::steady_clock::now();
+    const auto  items = UploadCandidates(candidates);
+    if (items > 0)
+    {
+      Reserve(items);
+      cuda::LaunchGatherCandidateCorners(m_Batch, items, m_Corners.Data(), m_Tetrahedra.Data(), m_Stream->Get());
+    }
+    Run(items);
     std::vector<std::size_t> first(candidates.size() + 1, 0);
     for (std::size_t i = 0; i < candidates.size(); ++i)
       first[i + 1] = first[i] + candidates[i].element->dependentTetrahedra.size();
-    const std::size_t items = first.back();
-    Reserve(items);
-    m_Pool.ParallelFor(candidates.size(), [&](std::size_t i) {
-      const PartialCandidate & c = candidates[i];
-      const auto &             dependent = c.element->dependentTetrahedra;
-      Corners                  source, target;
-      for (std::size_t k = 0; k < dependent.size(); ++k)
-      {
-        CandidateCorners(c, tets[dependent[k]], source, target);
-        Pack(first[i] + k, dependent[k], source, target);
-      }
-    });
-    Run(items);
-    m_Pool.ParallelFor(candidates.size(), [&](std::size_t i) {
-      for (std::size_t k = 0; k < candidates[i].element->dependentTetrahedra.size(); ++k)
-        candidates[i].values[k] = Unpack(first[i] + k);
-    });
+    UnpackAll(first, [&](std::size_t i) { return candidates[i].values; });
     m_Statistics.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
 
@@ -158,14 +167,10 @@ private:
   }
 
   cuda::PackedVolumeView
-  UploadPacked(const ChannelVolume & volume, cuda::DeviceArray<float> & device,
-               std::unique_ptr<cuda::Texture3D> & texture, CudaInterpolation interpolation)
+  UploadPacked(const ChannelVolume & volume, cuda::DeviceArray<float> & device, VolumeTextures & textures,
+               CudaInterpolation interpolation)
   {
-    const std::size_t  voxels = volume.size[0] * volume.size[1] * volume.size[2];
-    std::vector<float> packed(4 * voxels, 0.0f);
-    for (std::size_t v = 0; v < voxels; ++v)
-      for (std::size_t c = 0; c < volume.channels; ++c)
-        packed[4 * v + c] = volume.data[volume.channels * v + c];
+    const std::size_t      voxels = volume.size[0] * volume.size[1] * volume.size[2];
     cuda::PackedVolumeView view;
     for (int a = 0; a < 3; ++a)
     {
@@ -176,17 +181,148 @@ private:
     }
     if (interpolation == CudaInterpolation::Texture)
     {
-      texture = std::make_unique<cuda::Texture3D>(packed.data(), view.size);
-      view.texture = static_cast<unsigned long long>(texture->Get());
+      // Intensity in [0, 1] as 16-bit normalised texels; a foreground value
+      // never rounds to the background's 0.
+      std::vector<std::uint16_t> intensity(voxels);
+      for (std::size_t v = 0; v < voxels; ++v)
+      {
+        const double x = std::clamp(static_cast<double>(volume.data[volume.channels * v]), 0.0, 1.0);
+        intensity[v] = x > 0.0 ? static_cast<std::uint16_t>(std::max(1.0, std::round(x * 65535.0))) : 0;
+      }
+      textures.intensity = std::make_unique<cuda::Texture3D>(
+        intensity.data(), sizeof(std::uint16_t), cudaCreateChannelDesc<unsigned short>(), view.size);
+      view.intensityTexture = static_cast<unsigned long long>(textures.intensity->Get());
+      const std::size_t structures = volume.channels - 1;
+      if (structures > 0)
+      {
+        const int          channels = structures == 1 ? 1 : (structures == 2 ? 2 : 4);
+        // Padding channels hold a distance no radius reaches.
+        std::vector<float> distance(channels * voxels, 3.0e38f);
+        for (std::size_t v = 0; v < voxels; ++v)
+          for (std::size_t g = 0; g < structures; ++g)
+            distance[channels * v + g] = volume.data[volume.channels * v + 1 + g];
+        const cudaChannelFormatDesc format = cudaCreateChannelDesc(32, channels > 1 ? 32 : 0, channels > 2 ? 32 : 0,
+                                                                   channels > 2 ? 32 : 0, cudaChannelFormatKindFloat);
+        textures.distance =
+          std::make_unique<cuda::Texture3D>(distance.data(), channels * sizeof(float), format, view.size);
+        view.distanceTexture = static_cast<unsigned long long>(textures.distance->Get());
+        view.distanceChannels = channels;
+      }
+      return view;
     }
-    else
-    {
-      device.Reserve(packed.size());
-      Check(cudaMemcpy(device.Data(), packed.data(), packed.size() * sizeof(float), cudaMemcpyHostToDevice),
-            "uploading an image");
-      view.data = device.Data();
-    }
+    std::vector<float> packed(4 * voxels, 0.0f);
+    for (std::size_t v = 0; v < voxels; ++v)
+      for (std::size_t c = 0; c < volume.channels; ++c)
+        packed[4 * v + c] = volume.data[volume.channels * v + c];
+    device.Reserve(packed.size());
+    Check(cudaMemcpy(device.Data(), packed.data(), packed.size() * sizeof(float), cudaMemcpyHostToDevice),
+          "uploading an image");
+    view.data = device.Data();
     return view;
+  }
+
+  /** Uploads the batch's parents (each once), elements (each once),
+   *  candidate table and moved points; returns the number of items. */
+  std::size_t
+  UploadCandidates(const std::vector<PartialCandidate> & candidates)
+  {
+    std::unordered_map<const DualMesh *, std::uint32_t>   parentSlot;
+    std::unordered_map<const FosElement *, std::uint32_t> elementSlot;
+    std::vector<const DualMesh *>                         parents;
+    std::vector<std::uint32_t> pointOffsets{ 0 }, points, tetrahedronOffsets{ 0 }, dependent;
+    std::vector<std::uint32_t> candidateElement, candidateParent, candidateMoved;
+    std::vector<std::uint64_t> firstItem{ 0 };
+    std::vector<double>        moved;
+    for (const PartialCandidate & c : candidates)
+    {
+      const auto p = parentSlot.emplace(c.parent, static_cast<std::uint32_t>(parents.size()));
+      if (p.second)
+        parents.push_back(c.parent);
+      const auto e = elementSlot.emplace(c.element, static_cast<std::uint32_t>(pointOffsets.size() - 1));
+      if (e.second)
+      {
+        points.insert(points.end(), c.element->points.begin(), c.element->points.end());
+        pointOffsets.push_back(static_cast<std::uint32_t>(points.size()));
+        dependent.insert(dependent.end(), c.element->dependentTetrahedra.begin(), c.element->dependentTetrahedra.end());
+        tetrahedronOffsets.push_back(static_cast<std::uint32_t>(dependent.size()));
+      }
+      candidateElement.push_back(e.first->second);
+      candidateParent.push_back(p.first->second);
+      candidateMoved.push_back(static_cast<std::uint32_t>(moved.size() / 6));
+      for (std::size_t k = 0; k < c.element->points.size(); ++k)
+      {
+        moved.insert(moved.end(), c.source[k].begin(), c.source[k].end());
+        moved.insert(moved.end(), c.target[k].begin(), c.target[k].end());
+      }
+      firstItem.push_back(firstItem.back() + c.element->dependentTetrahedra.size());
+    }
+    const std::size_t items = firstItem.back();
+    if (items == 0)
+      return 0;
+    const std::size_t perParent = 6 * static_cast<std::size_t>(m_Batch.points);
+    m_HostParents.Reserve(parents.size() * perParent);
+    m_Pool.ParallelFor(parents.size(), [&](std::size_t slot) {
+      double * out = m_HostParents.Data() + slot * perParent;
+      for (const Vec3 & v : parents[slot]->source)
+        out = std::copy(v.begin(), v.end(), out);
+      for (const Vec3 & v : parents[slot]->target)
+        out = std::copy(v.begin(), v.end(), out);
+    });
+    m_Batch.parents = UploadAsync(m_HostParents.Data(), parents.size() * perParent, m_Parents);
+    m_Batch.elementPointOffsets = StageAndUpload(pointOffsets, m_HostElementPointOffsets, m_ElementPointOffsets);
+    m_Batch.elementPoints = StageAndUpload(points, m_HostElementPoints, m_ElementPoints);
+    m_Batch.elementTetrahedronOffsets =
+      StageAndUpload(tetrahedronOffsets, m_HostElementTetrahedronOffsets, m_ElementTetrahedronOffsets);
+    m_Batch.elementTetrahedra = StageAndUpload(dependent, m_HostElementTetrahedra, m_ElementTetrahedra);
+    m_Batch.candidateElement = StageAndUpload(candidateElement, m_HostCandidateElement, m_CandidateElement);
+    m_Batch.candidateParent = StageAndUpload(candidateParent, m_HostCandidateParent, m_CandidateParent);
+    m_Batch.candidateMoved = StageAndUpload(candidateMoved, m_HostCandidateMoved, m_CandidateMoved);
+    m_Batch.candidateFirstItem = StageAndUpload(firstItem, m_HostFirstItem, m_FirstItem);
+    m_Batch.moved = StageAndUpload(moved, m_HostMoved, m_Moved);
+    m_Batch.candidates = candidates.size();
+    return items;
+  }
+
+  /** Copies `count` elements from pinned host memory to `device` on the stream. */
+  template <typename T>
+  const T *
+  UploadAsync(const T * pinned, std::size_t count, cuda::DeviceArray<T> & device)
+  {
+    device.Reserve(std::max<std::size_t>(1, count));
+    Check(cudaMemcpyAsync(device.Data(), pinned, count * sizeof(T), cudaMemcpyHostToDevice, m_Stream->Get()),
+          "copying a batch to the device");
+    return device.Data();
+  }
+
+  /** Stages `host` in pinned memory (kept until the next call, which
+   *  synchronises first) and uploads it asynchronously. */
+  template <typename T>
+  const T *
+  StageAndUpload(const std::vector<T> & host, cuda::PinnedArray<T> & pinned, cuda::DeviceArray<T> & device)
+  {
+    pinned.Reserve(std::max<std::size_t>(1, host.size()));
+    std::copy(host.begin(), host.end(), pinned.Data());
+    return UploadAsync(pinned.Data(), host.size(), device);
+  }
+
+  bool
+  UsesTexturePath() const
+  {
+    return m_Constants.packed && m_Constants.interpolation == cuda::Interpolation::Texture;
+  }
+
+  void
+  CopyCornersToDevice(std::size_t items)
+  {
+    if (items == 0)
+      return;
+    cudaStream_t stream = m_Stream->Get();
+    Check(cudaMemcpyAsync(m_Corners.Data(), m_HostCorners.Data(), items * cuda::ItemCorners * sizeof(double),
+                          cudaMemcpyHostToDevice, stream),
+          "copying corners to the device");
+    Check(cudaMemcpyAsync(m_Tetrahedra.Data(), m_HostTetrahedra.Data(), items * sizeof(std::uint32_t),
+                          cudaMemcpyHostToDevice, stream),
+          "copying tetrahedron indices to the device");
   }
 
   void
@@ -200,6 +336,8 @@ private:
     m_Tetrahedra.Reserve(items);
     m_ItemValues.Reserve(items * cuda::ItemValues);
     m_DirectionValues.Reserve(items * 2 * cuda::DirectionValues);
+    if (UsesTexturePath())
+      m_Workspace.Reserve(cuda::TexturePrepareWorkspaceBytes(items));
   }
 
   void
@@ -236,15 +374,21 @@ private:
     if (items == 0)
       return;
     cudaStream_t stream = m_Stream->Get();
-    Check(cudaMemcpyAsync(m_Corners.Data(), m_HostCorners.Data(), items * cuda::ItemCorners * sizeof(double),
-                          cudaMemcpyHostToDevice, stream),
-          "copying corners to the device");
-    Check(cudaMemcpyAsync(m_Tetrahedra.Data(), m_HostTetrahedra.Data(), items * sizeof(std::uint32_t),
-                          cudaMemcpyHostToDevice, stream),
-          "copying tetrahedron indices to the device");
     Check(cudaEventRecord(m_KernelStart->Get(), stream), "recording an event");
-    cuda::LaunchEvaluateTetrahedra(m_Constants, m_Corners.Data(), m_Tetrahedra.Data(), items, m_ItemValues.Data(),
-                                   m_DirectionValues.Data(), stream);
+    if (UsesTexturePath())
+    {
+      // Step 1 tells how many chunks step 2 has: one synchronisation.
+      cuda::LaunchPrepareTexture(m_Constants, m_Corners.Data(), m_Tetrahedra.Data(), items, m_Workspace.Data(),
+                                 m_ItemValues.Data(), m_HostChunks.Data(), stream);
+      Check(cudaStreamSynchronize(stream), "preparing the texture sampling");
+      const std::size_t chunks = m_HostChunks[0];
+      m_ChunkWorkspace.Reserve(cuda::TextureChunkWorkspaceBytes(chunks));
+      cuda::LaunchSampleTexture(m_Constants, items, m_Workspace.Data(), chunks, m_ChunkWorkspace.Data(),
+                                m_DirectionValues.Data(), stream);
+    }
+    else
+      cuda::LaunchEvaluateTetrahedra(m_Constants, m_Corners.Data(), m_Tetrahedra.Data(), items, m_ItemValues.Data(),
+                                     m_DirectionValues.Data(), stream);
     Check(cudaEventRecord(m_KernelEnd->Get(), stream), "recording an event");
     Check(cudaMemcpyAsync(m_HostItemValues.Data(), m_ItemValues.Data(), items * cuda::ItemValues * sizeof(double),
                           cudaMemcpyDeviceToHost, stream),
@@ -258,9 +402,27 @@ private:
     m_Statistics.kernelSeconds += 1e-3 * milliseconds;
     ++m_Statistics.batches;
     m_Statistics.tetrahedra += items;
-    const double * d = m_HostDirectionValues.Data();
-    for (std::size_t i = 0; i < items; ++i)
-      m_Statistics.samples += d[i * 2 * cuda::DirectionValues + 2] + d[i * 2 * cuda::DirectionValues + 5];
+  }
+
+  /** Unpacks items [first[i], first[i + 1]) into out(i) for every i on the
+   *  pool, counting the samples on the way. */
+  template <typename Output>
+  void
+  UnpackAll(const std::vector<std::size_t> & first, Output out)
+  {
+    const std::size_t   groups = first.size() - 1;
+    std::vector<double> samples(groups, 0.0);
+    m_Pool.ParallelFor(groups, [&](std::size_t i) {
+      TetrahedronValues * o = out(i);
+      for (std::size_t item = first[i]; item < first[i + 1]; ++item)
+      {
+        *o = Unpack(item);
+        samples[i] += o->samples;
+        ++o;
+      }
+    });
+    for (double v : samples)
+      m_Statistics.samples += v;
   }
 
   const TetrahedronEvaluator &  m_Evaluator;
@@ -269,12 +431,24 @@ private:
   std::unique_ptr<cuda::Event>  m_KernelStart, m_KernelEnd;
   cuda::EvaluationConstants     m_Constants;
   cuda::DeviceArray<float>      m_Moving, m_Fixed, m_PackedMoving, m_PackedFixed;
-  std::unique_ptr<cuda::Texture3D> m_MovingTexture, m_FixedTexture;
+  VolumeTextures m_MovingTextures, m_FixedTextures;
   cuda::DeviceArray<double>     m_GuidanceWeights, m_Elasticity, m_ReferenceVolumes;
   cuda::DeviceArray<double>     m_Corners, m_ItemValues, m_DirectionValues;
   cuda::DeviceArray<std::uint32_t> m_Tetrahedra;
   cuda::PinnedArray<double>        m_HostCorners, m_HostItemValues, m_HostDirectionValues;
   cuda::PinnedArray<std::uint32_t> m_HostTetrahedra;
+  cuda::DeviceArray<unsigned char> m_Workspace, m_ChunkWorkspace;
+  cuda::PinnedArray<std::uint32_t> m_HostChunks; ///< step 1's number of chunks
+  // Partial candidates: the mesh once, then per batch (device and staging).
+  cuda::CandidateBatch             m_Batch;
+  cuda::DeviceArray<std::uint32_t> m_Mesh, m_ElementPointOffsets, m_ElementPoints, m_ElementTetrahedronOffsets,
+    m_ElementTetrahedra, m_CandidateElement, m_CandidateParent, m_CandidateMoved;
+  cuda::DeviceArray<std::uint64_t> m_FirstItem;
+  cuda::DeviceArray<double>        m_Parents, m_Moved;
+  cuda::PinnedArray<std::uint32_t> m_HostElementPointOffsets, m_HostElementPoints, m_HostElementTetrahedronOffsets,
+    m_HostElementTetrahedra, m_HostCandidateElement, m_HostCandidateParent, m_HostCandidateMoved;
+  cuda::PinnedArray<std::uint64_t> m_HostFirstItem;
+  cuda::PinnedArray<double>        m_HostParents, m_HostMoved;
 };
 } // namespace
 

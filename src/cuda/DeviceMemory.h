@@ -131,18 +131,18 @@ public:
 private:
   cudaStream_t m_Stream{ nullptr };
 };
-/** A 3D float4 texture with trilinear filtering (clamped, unnormalised
- *  coordinates), owning its array. */
+/** A 3D texture with trilinear filtering (clamped, unnormalised
+ *  coordinates), owning its array. `voxels` holds `bytesPerVoxel` bytes per
+ *  voxel in `format`; integer formats read as normalised floats. */
 class Texture3D
 {
 public:
-  Texture3D(const float * float4Voxels, const int size[3])
+  Texture3D(const void * voxels, std::size_t bytesPerVoxel, const cudaChannelFormatDesc & format, const int size[3])
   {
-    const cudaChannelFormatDesc format = cudaCreateChannelDesc<float4>();
-    const cudaExtent            extent = make_cudaExtent(size[0], size[1], size[2]);
+    const cudaExtent extent = make_cudaExtent(size[0], size[1], size[2]);
     Check(cudaMalloc3DArray(&m_Array, &format, extent), "allocating a texture array");
     cudaMemcpy3DParms copy{};
-    copy.srcPtr = make_cudaPitchedPtr(const_cast<float *>(float4Voxels), size[0] * 4 * sizeof(float), size[0], size[1]);
+    copy.srcPtr = make_cudaPitchedPtr(const_cast<void *>(voxels), size[0] * bytesPerVoxel, size[0], size[1]);
     copy.dstArray = m_Array;
     copy.extent = extent;
     copy.kind = cudaMemcpyHostToDevice;
@@ -153,7 +153,8 @@ public:
     cudaTextureDesc description{};
     description.addressMode[0] = description.addressMode[1] = description.addressMode[2] = cudaAddressModeClamp;
     description.filterMode = cudaFilterModeLinear;
-    description.readMode = cudaReadModeElementType;
+    description.readMode =
+      format.f == cudaChannelFormatKindFloat ? cudaReadModeElementType : cudaReadModeNormalizedFloat;
     description.normalizedCoords = 0;
     Check(cudaCreateTextureObject(&m_Texture, &resource, &description, nullptr), "creating a texture");
   }

@@ -7,6 +7,7 @@
 #include "TetrahedronKernels.h"
 
 #include "DeviceMemory.h"
+#include "TetrahedronDevice.cuh"
 
 #include <cstdint>
 
@@ -14,126 +15,11 @@ namespace morea::cuda
 {
 namespace
 {
+using namespace device;
+
 __constant__ std::uint32_t c_SobolDirections[4 * 32];
 
 constexpr int WarpsPerBlock = 8;
-
-__device__ std::uint64_t
-SplitMix64(std::uint64_t & x)
-{
-  std::uint64_t z = (x += 0x9E3779B97F4A7C15ULL);
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
-  return z ^ (z >> 31);
-}
-
-__device__ std::uint64_t
-HashCombine(std::uint64_t a, std::uint64_t b)
-{
-  std::uint64_t x = a;
-  x = SplitMix64(x) ^ b;
-  return SplitMix64(x);
-}
-
-__device__ std::uint64_t
-RotateLeft(std::uint64_t x, int k)
-{
-  return (x << k) | (x >> (64 - k));
-}
-
-/** The four digital shifts ScrambledSobol4 draws from a seed (xoshiro256**). */
-__device__ void
-SobolShifts(std::uint64_t seed, std::uint32_t shift[4])
-{
-  std::uint64_t s[4];
-  for (int i = 0; i < 4; ++i)
-    s[i] = SplitMix64(seed);
-  for (int i = 0; i < 4; ++i)
-  {
-    const std::uint64_t result = RotateLeft(s[1] * 5, 7) * 9;
-    const std::uint64_t t = s[1] << 17;
-    s[2] ^= s[0];
-    s[3] ^= s[1];
-    s[1] ^= s[2];
-    s[0] ^= s[3];
-    s[2] ^= t;
-    s[3] = RotateLeft(s[3], 45);
-    shift[i] = static_cast<std::uint32_t>(result >> 32);
-  }
-}
-
-__device__ std::uint64_t
-TetrahedronSeed(const double c[12])
-{
-  std::uint64_t h = 0x7465747261ull;
-  for (int i = 0; i < 12; ++i)
-    h = HashCombine(h, static_cast<std::uint64_t>(__double_as_longlong(c[i])));
-  return h;
-}
-
-/** Signed volume, rounded exactly as the CPU computes it (no contraction). */
-__device__ double
-SignedVolume(const double c[12])
-{
-  const double ux = __dsub_rn(c[3], c[0]), uy = __dsub_rn(c[4], c[1]), uz = __dsub_rn(c[5], c[2]);
-  const double vx = __dsub_rn(c[6], c[0]), vy = __dsub_rn(c[7], c[1]), vz = __dsub_rn(c[8], c[2]);
-  const double wx = __dsub_rn(c[9], c[0]), wy = __dsub_rn(c[10], c[1]), wz = __dsub_rn(c[11], c[2]);
-  const double a = __dmul_rn(ux, __dsub_rn(__dmul_rn(vy, wz), __dmul_rn(vz, wy)));
-  const double b = __dmul_rn(uy, __dsub_rn(__dmul_rn(vx, wz), __dmul_rn(vz, wx)));
-  const double d = __dmul_rn(uz, __dsub_rn(__dmul_rn(vx, wy), __dmul_rn(vy, wx)));
-  return __ddiv_rn(__dadd_rn(__dsub_rn(a, b), d), 6.0);
-}
-
-__device__ double
-VolumeViolation(double v, double reference, double fraction, double & folded)
-{
-  const double size = fabs(reference);
-  const double oriented = reference > 0.0 ? v : -v;
-  const double lower = __dmul_rn(fraction, size);
-  if (!(oriented > lower))
-  {
-    folded += 1.0;
-    return __dsub_rn(lower, oriented);
-  }
-  if (fraction > 0.0 && __dmul_rn(oriented, fraction) > size)
-  {
-    folded += 1.0;
-    return __dsub_rn(oriented, __ddiv_rn(size, fraction));
-  }
-  return 0.0;
-}
-
-__device__ double
-Distance(const double * a, const double * b)
-{
-  const double x = a[0] - b[0], y = a[1] - b[1], z = a[2] - b[2];
-  return sqrt(x * x + y * y + z * z);
-}
-
-__device__ double
-TetrahedronMagnitude(const double s[12], const double t[12], double elasticity)
-{
-  double sum = 0.0;
-  for (int i = 0; i < 4; ++i)
-    for (int j = i + 1; j < 4; ++j)
-    {
-      const double d = Distance(s + 3 * i, s + 3 * j) - Distance(t + 3 * i, t + 3 * j);
-      sum += d * d;
-    }
-  double cs[3] = { 0.0, 0.0, 0.0 }, ct[3] = { 0.0, 0.0, 0.0 };
-  for (int i = 0; i < 4; ++i)
-    for (int a = 0; a < 3; ++a)
-    {
-      cs[a] += 0.25 * s[3 * i + a];
-      ct[a] += 0.25 * t[3 * i + a];
-    }
-  for (int i = 0; i < 4; ++i)
-  {
-    const double d = Distance(cs, s + 3 * i) - Distance(ct, t + 3 * i);
-    sum += d * d;
-  }
-  return elasticity * sum;
-}
 
 /** Trilinear interpolation set-up: the first voxel's offset, the channel
  *  strides to the 7 other corners and the 8 weights (ChannelVolume::Sample). */
@@ -264,39 +150,6 @@ struct PackedExact
     return Component(v, c);
   }
 };
-
-/** Up to 4 channels from one filtered texture fetch. */
-struct PackedTexture
-{
-  float4 v;
-
-  __device__
-  PackedTexture(const PackedVolumeView & image, const double p[3])
-  {
-    float x[3];
-    for (int a = 0; a < 3; ++a)
-    {
-      double       t = (p[a] - image.origin[a]) * image.inverseSpacing[a];
-      const double last = static_cast<double>(image.size[a] - 1);
-      t = t < 0.0 ? 0.0 : (t > last ? last : t);
-      x[a] = static_cast<float>(t) + 0.5f; // texel centres lie at +0.5
-    }
-    v = tex3D<float4>(static_cast<cudaTextureObject_t>(image.texture), x[0], x[1], x[2]);
-  }
-  __device__ float
-  Channel(int c) const
-  {
-    return Component(v, c);
-  }
-};
-
-__device__ double
-WarpSum(double x)
-{
-  for (int offset = 16; offset > 0; offset >>= 1)
-    x += __shfl_down_sync(0xffffffffu, x, offset);
-  return x;
-}
 
 template <typename Sampler, typename View>
 __global__ void __launch_bounds__(256, 2)
@@ -430,6 +283,7 @@ UploadSobolDirections(const std::uint32_t * directions)
 {
   Check(cudaMemcpyToSymbol(c_SobolDirections, directions, sizeof(std::uint32_t) * 4 * 32),
         "copying the Sobol direction numbers");
+  UploadTextureSobolDirections(directions); // the texture kernels' module has its own copy
 }
 
 void
@@ -447,11 +301,8 @@ LaunchEvaluateTetrahedra(const EvaluationConstants & constants, const double * c
   if (!k.packed)
     EvaluateTetrahedraKernel<Trilinear><<<grid, WarpsPerBlock * 32, 0, s>>>(k, k.moving, k.fixed, corners, tetrahedra,
                                                                            items, itemOut, directionOut);
-  else if (k.interpolation == Interpolation::Exact)
-    EvaluateTetrahedraKernel<PackedExact><<<grid, WarpsPerBlock * 32, 0, s>>>(
-      k, k.packedMoving, k.packedFixed, corners, tetrahedra, items, itemOut, directionOut);
   else
-    EvaluateTetrahedraKernel<PackedTexture><<<grid, WarpsPerBlock * 32, 0, s>>>(
+    EvaluateTetrahedraKernel<PackedExact><<<grid, WarpsPerBlock * 32, 0, s>>>(
       k, k.packedMoving, k.packedFixed, corners, tetrahedra, items, itemOut, directionOut);
   Check(cudaGetLastError(), "launching the tetrahedron kernel");
 }

@@ -26,12 +26,17 @@ enum class Interpolation
   Texture  ///< the texture units' trilinear filtering (9-bit weights: faster, not bit-comparable)
 };
 
-/** The same volume with its channels padded to 4 (float4 per voxel), in
- *  global memory for Exact and as a texture object for Texture. */
+/** A volume with at most 4 channels. Exact: channels padded to 4, float4
+ *  per voxel in global memory. Texture: the intensity as 16-bit normalised
+ *  texels (2 bytes: small footprint, many samples per cache line) and the
+ *  distance maps in a float texture of their own (1, 2 or 4 channels), read
+ *  only near a contour. */
 struct PackedVolumeView
 {
-  const void *       data{ nullptr };   ///< float4 per voxel
-  unsigned long long texture{ 0 };      ///< cudaTextureObject_t
+  const void *       data{ nullptr };            ///< Exact: float4 per voxel
+  unsigned long long intensityTexture{ 0 };      ///< Texture: cudaTextureObject_t
+  unsigned long long distanceTexture{ 0 };       ///< Texture: cudaTextureObject_t (0: no structures)
+  int                distanceChannels{ 0 };      ///< Texture: 1, 2 or 4
   int                size[3]{ 0, 0, 0 };
   double             origin[3]{ 0.0, 0.0, 0.0 };
   double             spacing[3]{ 1.0, 1.0, 1.0 };
@@ -55,6 +60,31 @@ struct EvaluationConstants
   bool             packed{ false };
   Interpolation    interpolation{ Interpolation::Exact };
   PackedVolumeView packedMoving, packedFixed;
+  /** Texture path: samples per chunk (one warp each), a multiple of 32.
+   *  64 to 512 measured within 10 % of each other on an H100. */
+  std::uint32_t chunkSamples{ 128 };
+  /** The guidance weights again, by value, for the texture kernels. */
+  float textureGuidanceWeights[3]{ 0.0f, 0.0f, 0.0f };
+};
+
+/** A batch of partial candidates as the device sees it: each candidate is a
+ *  parent (a slot in `parents`) with the points of one element (a slot in
+ *  the element tables) moved to new positions. */
+struct CandidateBatch
+{
+  const std::uint32_t * tetrahedra{ nullptr };  ///< the mesh: 4 point indices per tetrahedron
+  std::uint32_t         points{ 0 };            ///< points per mesh side
+  const double *        parents{ nullptr };     ///< per parent slot: source then target, points x 3
+  const std::uint32_t * elementPointOffsets{ nullptr };       ///< per element slot, plus one
+  const std::uint32_t * elementPoints{ nullptr };
+  const std::uint32_t * elementTetrahedronOffsets{ nullptr }; ///< per element slot, plus one
+  const std::uint32_t * elementTetrahedra{ nullptr };         ///< dependent tetrahedra
+  const std::uint32_t * candidateElement{ nullptr };          ///< element slot per candidate
+  const std::uint32_t * candidateParent{ nullptr };           ///< parent slot per candidate
+  const std::uint32_t * candidateMoved{ nullptr };            ///< first moved point per candidate
+  const std::uint64_t * candidateFirstItem{ nullptr };        ///< per candidate, plus one (= items)
+  std::size_t           candidates{ 0 };
+  const double *        moved{ nullptr }; ///< moved point m: source at 6 m, target at 6 m + 3
 };
 
 /** Per work item: magnitude, fold value, folded count. */
@@ -68,14 +98,53 @@ constexpr int ItemCorners = 24;
 void
 UploadSobolDirections(const std::uint32_t * directions);
 
-/** Evaluates `items` tetrahedra: `corners` (items x 24 doubles) and
- *  `tetrahedra` (items indices) on the device; writes `itemOut`
- *  (items x ItemValues) and `directionOut` (items x 2 x DirectionValues).
- *  Asynchronous on `stream` (a cudaStream_t); checks the launch. */
+/** Writes the corners (items x ItemCorners) and tetrahedron index of every
+ *  dependent tetrahedron of every candidate of `batch`, in candidate order:
+ *  the parents' points with each element's points replaced, as
+ *  CandidateCorners does on the host. Asynchronous on `stream`. */
+void
+LaunchGatherCandidateCorners(const CandidateBatch & batch, std::size_t items, double * corners,
+                             std::uint32_t * tetrahedra, void * stream);
+
+/** Evaluates `items` tetrahedra with the exact (software) interpolation:
+ *  `corners` (items x 24 doubles) and `tetrahedra` (items indices) on the
+ *  device; writes `itemOut` (items x ItemValues) and `directionOut`
+ *  (items x 2 x DirectionValues). Asynchronous on `stream` (a cudaStream_t);
+ *  checks the launch. */
 void
 LaunchEvaluateTetrahedra(const EvaluationConstants & constants, const double * corners,
                          const std::uint32_t * tetrahedra, std::size_t items, double * itemOut,
                          double * directionOut, void * stream);
+
+/** The texture path (packed images, Interpolation::Texture), built for
+ *  throughput in two steps around one synchronisation. Step 1, one thread
+ *  per tetrahedron: seeds, sample counts, corners in texel coordinates,
+ *  per-item values (`itemOut`) and the split of every direction's samples
+ *  into chunks of `chunkSamples`; the number of chunks goes to
+ *  `totalChunks` (pinned host memory) once the stream gets there. Step 2,
+ *  one warp per chunk in single precision, then the chunks' sums in a fixed
+ *  order (deterministic): `directionOut`. Large and small tetrahedra thus
+ *  load the GPU evenly. */
+/** Bytes of `workspace` step 1 needs for `items` tetrahedra. */
+std::size_t
+TexturePrepareWorkspaceBytes(std::size_t items);
+
+/** Bytes of `chunkWorkspace` step 2 needs for `chunks` chunks. */
+std::size_t
+TextureChunkWorkspaceBytes(std::size_t chunks);
+
+void
+LaunchPrepareTexture(const EvaluationConstants & constants, const double * corners, const std::uint32_t * tetrahedra,
+                     std::size_t items, void * workspace, double * itemOut, std::uint32_t * totalChunks,
+                     void * stream);
+
+void
+LaunchSampleTexture(const EvaluationConstants & constants, std::size_t items, void * workspace, std::size_t chunks,
+                    void * chunkWorkspace, double * directionOut, void * stream);
+
+/** Copies the Sobol direction numbers to the texture kernels' module. */
+void
+UploadTextureSobolDirections(const std::uint32_t * directions);
 } // namespace morea::cuda
 
 #endif

@@ -1,0 +1,75 @@
+// Builds the corners of every dependent tetrahedron of a batch of partial
+// candidates on the device, from the parents' points and each candidate's
+// moved points, so that the host uploads a few megabytes of points per batch
+// instead of 24 doubles per tetrahedron.
+#include "TetrahedronKernels.h"
+
+#include "DeviceMemory.h"
+
+#include <cstdint>
+
+namespace morea::cuda
+{
+namespace
+{
+constexpr int GatherThreads = 256;
+
+__global__ void
+GatherCandidateCorners(CandidateBatch b, std::size_t items, double * corners, std::uint32_t * tetrahedra)
+{
+  const std::size_t item = static_cast<std::size_t>(blockIdx.x) * blockDim.x + threadIdx.x;
+  if (item >= items)
+    return;
+  // The candidate is the last one whose first item is <= item (candidates
+  // without dependent tetrahedra own no item and are skipped this way).
+  std::size_t lo = 0, hi = b.candidates;
+  while (hi - lo > 1)
+  {
+    const std::size_t mid = (lo + hi) / 2;
+    if (b.candidateFirstItem[mid] <= item)
+      lo = mid;
+    else
+      hi = mid;
+  }
+  const std::size_t   c = lo;
+  const std::uint32_t e = b.candidateElement[c];
+  const std::uint32_t t =
+    b.elementTetrahedra[b.elementTetrahedronOffsets[e] + static_cast<std::uint32_t>(item - b.candidateFirstItem[c])];
+  const double *      source = b.parents + static_cast<std::size_t>(b.candidateParent[c]) * 6 * b.points;
+  const double *      target = source + 3 * static_cast<std::size_t>(b.points);
+  const std::uint32_t firstPoint = b.elementPointOffsets[e], endPoint = b.elementPointOffsets[e + 1];
+  double *            out = corners + item * ItemCorners;
+  for (int j = 0; j < 4; ++j)
+  {
+    const std::uint32_t v = b.tetrahedra[4 * static_cast<std::size_t>(t) + j];
+    const double *      s = source + 3 * static_cast<std::size_t>(v);
+    const double *      g = target + 3 * static_cast<std::size_t>(v);
+    for (std::uint32_t m = firstPoint; m < endPoint; ++m)
+      if (b.elementPoints[m] == v)
+      {
+        s = b.moved + 6 * static_cast<std::size_t>(b.candidateMoved[c] + (m - firstPoint));
+        g = s + 3;
+        break;
+      }
+    for (int a = 0; a < 3; ++a)
+    {
+      out[3 * j + a] = s[a];
+      out[12 + 3 * j + a] = g[a];
+    }
+  }
+  tetrahedra[item] = t;
+}
+} // namespace
+
+void
+LaunchGatherCandidateCorners(const CandidateBatch & batch, std::size_t items, double * corners,
+                             std::uint32_t * tetrahedra, void * stream)
+{
+  if (items == 0)
+    return;
+  const unsigned blocks = static_cast<unsigned>((items + GatherThreads - 1) / GatherThreads);
+  GatherCandidateCorners<<<blocks, GatherThreads, 0, static_cast<cudaStream_t>(stream)>>>(batch, items, corners,
+                                                                                          tetrahedra);
+  Check(cudaGetLastError(), "launching the corner gathering kernel");
+}
+} // namespace morea::cuda

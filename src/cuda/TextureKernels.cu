@@ -1,0 +1,432 @@
+// The texture-interpolation path of the tetrahedron evaluation, built for
+// throughput. Work that is the same for all samples of a tetrahedron (the
+// seed hash, Sobol shifts, sample count, corners in texel coordinates) runs
+// once per tetrahedron in a set-up kernel, one thread each, instead of once
+// per lane; the sampling kernel then works in single precision with few
+// registers, so that enough warps are resident to hide the texture latency.
+// A tetrahedron's samples are split into chunks of a few hundred, one warp
+// each: tetrahedra differ in size by orders of magnitude, and one warp per
+// tetrahedron left most of the GPU idle while the largest ones finished.
+// Sample points, sample counts and per-item values are those of the exact
+// path; only the interpolation weights (9 bits in the texture units), the
+// 16-bit intensity texels and the single-precision arithmetic differ.
+#include "TetrahedronKernels.h"
+
+#include "DeviceMemory.h"
+#include "TetrahedronDevice.cuh"
+
+#include <cub/device/device_scan.cuh>
+
+#include <cstdint>
+
+namespace morea::cuda
+{
+namespace
+{
+using namespace device;
+
+__constant__ std::uint32_t c_SobolDirections[4 * 32];
+
+/** One direction of one tetrahedron, ready to sample. */
+struct alignas(16) SampleTask
+{
+  float         from[12];    ///< sampled tetrahedron, texel coordinates of its image
+  float         to[12];      ///< mapped tetrahedron, texel coordinates of the other image
+  std::uint32_t shift[4];    ///< Sobol digital shifts
+  std::uint32_t samples;     ///< number of samples
+  std::uint32_t nearContour; ///< 0 when no sample can lie within the guidance radius of a contour
+  std::uint32_t padding[2];
+};
+static_assert(sizeof(SampleTask) == 128, "a task is one 128-byte line");
+
+constexpr int           PrepareThreads = 128;
+constexpr int           SampleWarpsPerBlock = 8;
+
+/** Step 1's workspace: tasks, chunks per task and their running sums, the
+ *  scan's temporary storage; 256-byte aligned parts. */
+struct PrepareWorkspace
+{
+  SampleTask *    tasks;
+  std::uint32_t * chunkCounts;
+  std::uint32_t * chunkEnds; ///< inclusive running sum of chunkCounts
+  void *          scanStorage;
+  std::size_t     scanBytes;
+};
+
+std::size_t
+Aligned(std::size_t bytes)
+{
+  return (bytes + 255) / 256 * 256;
+}
+
+std::size_t
+ScanBytes(std::size_t tasks)
+{
+  std::size_t bytes = 0;
+  Check(cub::DeviceScan::InclusiveSum(nullptr, bytes, static_cast<const std::uint32_t *>(nullptr),
+                                      static_cast<std::uint32_t *>(nullptr), static_cast<int>(tasks)),
+        "sizing the chunk scan");
+  return bytes;
+}
+
+PrepareWorkspace
+Partition(void * workspace, std::size_t items)
+{
+  const std::size_t tasks = 2 * items;
+  auto *            base = static_cast<unsigned char *>(workspace);
+  PrepareWorkspace  w;
+  w.tasks = reinterpret_cast<SampleTask *>(base);
+  base += Aligned(tasks * sizeof(SampleTask));
+  w.chunkCounts = reinterpret_cast<std::uint32_t *>(base);
+  base += Aligned(tasks * sizeof(std::uint32_t));
+  w.chunkEnds = reinterpret_cast<std::uint32_t *>(base);
+  base += Aligned(tasks * sizeof(std::uint32_t));
+  w.scanStorage = base;
+  w.scanBytes = ScanBytes(tasks);
+  return w;
+}
+
+/** Texel coordinates (centres at +0.5) of 4 corners. Clamping to the image
+ *  is left to the texture's clamp addressing, which gives the edge voxel's
+ *  value outside, as the exact path's clamped coordinates do. */
+__device__ void
+TexelCorners(const PackedVolumeView & image, const double c[12], float out[12])
+{
+#pragma unroll
+  for (int i = 0; i < 4; ++i)
+#pragma unroll
+    for (int a = 0; a < 3; ++a)
+      out[3 * i + a] = static_cast<float>((c[3 * i + a] - image.origin[a]) * image.inverseSpacing[a]) + 0.5f;
+}
+
+/** Distance maps at texel position `x` (channels 1, 2 or 4, padded to 4 with
+ *  a distance no radius reaches). */
+__device__ float4
+Distances(cudaTextureObject_t texture, int channels, float x, float y, float z)
+{
+  constexpr float far = 3.0e38f;
+  if (channels == 1)
+    return make_float4(tex3D<float>(texture, x, y, z), far, far, far);
+  if (channels == 2)
+  {
+    const float2 d = tex3D<float2>(texture, x, y, z);
+    return make_float4(d.x, d.y, far, far);
+  }
+  return tex3D<float4>(texture, x, y, z);
+}
+
+__device__ void
+PrepareDirection(const EvaluationConstants & k, const double from[12], const double to[12],
+                 const PackedVolumeView & fromImage, const PackedVolumeView & toImage, SampleTask & task)
+{
+  const double volume = fabs(SignedVolume(from));
+  const double count = round(__ddiv_rn(__dmul_rn(k.samplingRate, volume), k.voxelVolume));
+  task.samples = count < 1.0 ? 1u : static_cast<std::uint32_t>(count);
+  SobolShifts(TetrahedronSeed(from), task.shift);
+  TexelCorners(fromImage, from, task.from);
+  TexelCorners(toImage, to, task.to);
+
+  // Guidance counts only samples whose distance (in the sampled image) is
+  // below the radius. The interpolated distance map changes by at most 1 per
+  // mm along each axis (2 per mm in any direction, with room to spare), so a
+  // tetrahedron whose centre is farther than radius + 2 x (its largest
+  // centre-corner distance) + a rounding margin has no such sample.
+  task.nearContour = 0;
+  if (fromImage.distanceTexture == 0)
+    return;
+  double centre[3] = { 0.0, 0.0, 0.0 }, reach = 0.0, spacing = 0.0;
+  for (int a = 0; a < 3; ++a)
+  {
+    centre[a] = 0.25 * (from[a] + from[3 + a] + from[6 + a] + from[9 + a]);
+    spacing = fmax(spacing, fromImage.spacing[a]);
+  }
+  for (int i = 0; i < 4; ++i)
+  {
+    const double x = from[3 * i] - centre[0], y = from[3 * i + 1] - centre[1], z = from[3 * i + 2] - centre[2];
+    reach = fmax(reach, sqrt(x * x + y * y + z * z));
+  }
+  float t[3];
+  for (int a = 0; a < 3; ++a)
+    t[a] = static_cast<float>((centre[a] - fromImage.origin[a]) * fromImage.inverseSpacing[a]) + 0.5f;
+  const float4 d = Distances(static_cast<cudaTextureObject_t>(fromImage.distanceTexture), fromImage.distanceChannels,
+                             t[0], t[1], t[2]);
+  const double nearest = fmin(fmin(d.x, d.y), fmin(d.z, d.w));
+  const double margin = 0.02 * spacing + 1e-4 * fabs(nearest);
+  task.nearContour = nearest - 2.0 * reach - margin < k.guidanceRadius ? 1u : 0u;
+}
+
+__global__ void
+PrepareTextureTasks(EvaluationConstants k, const double * __restrict__ corners,
+                    const std::uint32_t * __restrict__ tetrahedra, std::size_t items, SampleTask * tasks,
+                    std::uint32_t * chunkCounts, double * itemOut)
+{
+  const std::size_t item = static_cast<std::size_t>(blockIdx.x) * blockDim.x + threadIdx.x;
+  if (item >= items)
+    return;
+  double source[12], target[12];
+  const double * c = corners + item * ItemCorners;
+#pragma unroll
+  for (int i = 0; i < 12; ++i)
+  {
+    source[i] = c[i];
+    target[i] = c[12 + i];
+  }
+  SampleTask task;
+  PrepareDirection(k, source, target, k.packedMoving, k.packedFixed, task);
+  tasks[2 * item] = task;
+  chunkCounts[2 * item] = (task.samples + k.chunkSamples - 1) / k.chunkSamples;
+  PrepareDirection(k, target, source, k.packedFixed, k.packedMoving, task);
+  tasks[2 * item + 1] = task;
+  chunkCounts[2 * item + 1] = (task.samples + k.chunkSamples - 1) / k.chunkSamples;
+
+  const std::uint32_t t = tetrahedra[item];
+  double              folded = 0.0;
+  double              value = VolumeViolation(SignedVolume(source), k.referenceVolumes[t], k.volumeFraction, folded);
+  value += VolumeViolation(SignedVolume(target), k.referenceVolumes[t], k.volumeFraction, folded);
+  double * o = itemOut + item * ItemValues;
+  o[0] = TetrahedronMagnitude(source, target, k.elasticity ? k.elasticity[t] : 1.0);
+  o[1] = value;
+  o[2] = folded;
+}
+
+__device__ float
+Component(const float4 & v, int c)
+{
+  return c == 0 ? v.x : (c == 1 ? v.y : (c == 2 ? v.z : v.w));
+}
+
+/** What the sampling kernel needs besides the tasks, by value. */
+struct SamplingConstants
+{
+  cudaTextureObject_t movingIntensity, fixedIntensity, movingDistance, fixedDistance;
+  int                 distanceChannels;
+  float               guidanceWeights[3];
+  float               radius, inverseRadius;
+  int                 structures;
+  std::uint32_t       chunkIterations; ///< 32 samples each
+};
+
+/** Which task each chunk belongs to. */
+__global__ void
+ScatterChunkTasks(const std::uint32_t * __restrict__ chunkCounts, const std::uint32_t * __restrict__ chunkEnds,
+                  std::size_t tasks, std::uint32_t * chunkTask)
+{
+  const std::size_t task = static_cast<std::size_t>(blockIdx.x) * blockDim.x + threadIdx.x;
+  if (task >= tasks)
+    return;
+  const std::uint32_t end = chunkEnds[task];
+  for (std::uint32_t c = end - chunkCounts[task]; c < end; ++c)
+    chunkTask[c] = static_cast<std::uint32_t>(task);
+}
+
+__global__ void __launch_bounds__(SampleWarpsPerBlock * 32, 4)
+SampleTextureChunks(SamplingConstants k, const SampleTask * __restrict__ tasks,
+                    const std::uint32_t * __restrict__ chunkCounts, const std::uint32_t * __restrict__ chunkEnds,
+                    const std::uint32_t * __restrict__ chunkTask, std::size_t chunks, double2 * chunkSums)
+{
+  const std::size_t chunk = (static_cast<std::size_t>(blockIdx.x) * blockDim.x + threadIdx.x) / 32;
+  const int         lane = threadIdx.x & 31;
+  if (chunk >= chunks)
+    return; // whole warps leave together
+  const std::uint32_t t = __ldg(chunkTask + chunk);
+  const std::uint32_t local = static_cast<std::uint32_t>(chunk) - (__ldg(chunkEnds + t) - __ldg(chunkCounts + t));
+  const int           direction = static_cast<int>(t & 1u);
+
+  // All lanes read the same task: one transaction per 16-byte load.
+  const float4 * q = reinterpret_cast<const float4 *>(tasks + t);
+  float          from[12], to[12];
+#pragma unroll
+  for (int i = 0; i < 3; ++i)
+  {
+    const float4 a = __ldg(q + i), b = __ldg(q + 3 + i);
+    from[4 * i] = a.x, from[4 * i + 1] = a.y, from[4 * i + 2] = a.z, from[4 * i + 3] = a.w;
+    to[4 * i] = b.x, to[4 * i + 1] = b.y, to[4 * i + 2] = b.z, to[4 * i + 3] = b.w;
+  }
+  const uint4               shift = __ldg(reinterpret_cast<const uint4 *>(q + 6));
+  const std::uint32_t       n = __ldg(reinterpret_cast<const std::uint32_t *>(q + 7));
+  const bool                near = __ldg(reinterpret_cast<const std::uint32_t *>(q + 7) + 1) != 0;
+  const cudaTextureObject_t fromIntensity = direction == 0 ? k.movingIntensity : k.fixedIntensity;
+  const cudaTextureObject_t toIntensity = direction == 0 ? k.fixedIntensity : k.movingIntensity;
+  const cudaTextureObject_t fromDistance = direction == 0 ? k.movingDistance : k.fixedDistance;
+  const cudaTextureObject_t toDistance = direction == 0 ? k.fixedDistance : k.movingDistance;
+
+  // Sample 32 j + lane: this lane's fixed part of the Sobol state XOR a part
+  // shared by the warp (see TetrahedronKernels.cu).
+  const std::uint32_t gray = static_cast<std::uint32_t>(lane) ^ (static_cast<std::uint32_t>(lane) >> 1);
+  std::uint32_t       laneState[4] = { shift.x, shift.y, shift.z, shift.w };
+#pragma unroll
+  for (int d = 0; d < 4; ++d)
+#pragma unroll
+    for (int b = 0; b < 5; ++b)
+      if ((gray >> b) & 1u)
+        laneState[d] ^= c_SobolDirections[d * 32 + b];
+
+  float               intensity = 0.0f, guidance = 0.0f;
+  const std::uint32_t firstJ = local * k.chunkIterations;
+  for (std::uint32_t j = firstJ; j < firstJ + k.chunkIterations && 32 * j < n; ++j)
+  {
+    std::uint32_t shared[4] = { 0, 0, 0, 0 };
+    for (std::uint32_t bits = (2 * j) ^ j, b = 4; bits; bits >>= 1, ++b) // warp-uniform loop
+      if (bits & 1u)
+#pragma unroll
+        for (int d = 0; d < 4; ++d)
+          shared[d] ^= c_SobolDirections[d * 32 + b];
+    if (32 * j + lane >= n)
+      break;
+    float w[4], sum = 0.0f;
+#pragma unroll
+    for (int d = 0; d < 4; ++d)
+    {
+      const float u = (static_cast<float>(laneState[d] ^ shared[d]) + 0.5f) * 2.3283064365386963e-10f;
+      sum += (w[d] = -__logf(u));
+    }
+    const float inverseSum = 1.0f / sum;
+    float       p[3], r[3];
+#pragma unroll
+    for (int a = 0; a < 3; ++a)
+    {
+      p[a] = (w[0] * from[a] + w[1] * from[3 + a] + w[2] * from[6 + a] + w[3] * from[9 + a]) * inverseSum;
+      r[a] = (w[0] * to[a] + w[1] * to[3 + a] + w[2] * to[6 + a] + w[3] * to[9 + a]) * inverseSum;
+    }
+    const float a = tex3D<float>(fromIntensity, p[0], p[1], p[2]);
+    const float b = tex3D<float>(toIntensity, r[0], r[1], r[2]);
+    if (a > 0.0f && b > 0.0f)
+    {
+      const float d = a - b;
+      intensity += d * d;
+    }
+    else if (a > 0.0f || b > 0.0f)
+      intensity += 1.0f;
+    if (near) // the same for the whole warp
+    {
+      const float4 da = Distances(fromDistance, k.distanceChannels, p[0], p[1], p[2]);
+      if (fminf(fminf(da.x, da.y), fminf(da.z, da.w)) < k.radius)
+      {
+        const float4 db = Distances(toDistance, k.distanceChannels, r[0], r[1], r[2]);
+#pragma unroll
+        for (int g = 0; g < 3; ++g)
+          if (g < k.structures)
+          {
+            const float d = Component(da, g);
+            if (d < k.radius)
+            {
+              const float e = d - Component(db, g);
+              guidance += k.guidanceWeights[g] * (k.radius - d) * k.inverseRadius * e * e;
+            }
+          }
+      }
+    }
+  }
+  const double intensitySum = WarpSum(static_cast<double>(intensity));
+  const double guidanceSum = WarpSum(static_cast<double>(guidance));
+  if (lane == 0)
+    chunkSums[chunk] = make_double2(intensitySum, guidanceSum);
+}
+
+/** Each direction's chunk sums in chunk order: the result does not depend on
+ *  how the warps were scheduled. */
+__global__ void
+SumChunks(const SampleTask * __restrict__ tasks, const std::uint32_t * __restrict__ chunkCounts,
+          const std::uint32_t * __restrict__ chunkEnds, const double2 * __restrict__ chunkSums, std::size_t tasksCount,
+          double * directionOut)
+{
+  const std::size_t task = static_cast<std::size_t>(blockIdx.x) * blockDim.x + threadIdx.x;
+  if (task >= tasksCount)
+    return;
+  const std::uint32_t end = chunkEnds[task];
+  double              intensity = 0.0, guidance = 0.0;
+  for (std::uint32_t c = end - chunkCounts[task]; c < end; ++c)
+  {
+    const double2 s = chunkSums[c];
+    intensity += s.x;
+    guidance += s.y;
+  }
+  double * out = directionOut + task * DirectionValues;
+  out[0] = intensity;
+  out[1] = guidance;
+  out[2] = static_cast<double>(tasks[task].samples);
+}
+} // namespace
+
+void
+UploadTextureSobolDirections(const std::uint32_t * directions)
+{
+  Check(cudaMemcpyToSymbol(c_SobolDirections, directions, sizeof(std::uint32_t) * 4 * 32),
+        "copying the Sobol direction numbers");
+}
+
+std::size_t
+TexturePrepareWorkspaceBytes(std::size_t items)
+{
+  const std::size_t tasks = 2 * items;
+  return Aligned(tasks * sizeof(SampleTask)) + 2 * Aligned(tasks * sizeof(std::uint32_t)) + ScanBytes(tasks);
+}
+
+std::size_t
+TextureChunkWorkspaceBytes(std::size_t chunks)
+{
+  return Aligned(chunks * sizeof(double2)) + Aligned(chunks * sizeof(std::uint32_t));
+}
+
+void
+LaunchPrepareTexture(const EvaluationConstants & constants, const double * corners, const std::uint32_t * tetrahedra,
+                     std::size_t items, void * workspace, double * itemOut, std::uint32_t * totalChunks,
+                     void * stream)
+{
+  if (items == 0)
+    return;
+  if (2 * items > 0x7fffffffu)
+    throw Error("CUDA backend: too many tetrahedra in one batch");
+  const cudaStream_t     s = static_cast<cudaStream_t>(stream);
+  const PrepareWorkspace w = Partition(workspace, items);
+  const unsigned         blocks = static_cast<unsigned>((items + PrepareThreads - 1) / PrepareThreads);
+  PrepareTextureTasks<<<blocks, PrepareThreads, 0, s>>>(constants, corners, tetrahedra, items, w.tasks,
+                                                        w.chunkCounts, itemOut);
+  Check(cudaGetLastError(), "launching the texture set-up kernel");
+  std::size_t scanBytes = w.scanBytes;
+  Check(cub::DeviceScan::InclusiveSum(w.scanStorage, scanBytes, w.chunkCounts, w.chunkEnds,
+                                      static_cast<int>(2 * items), s),
+        "scanning the chunk counts");
+  Check(cudaMemcpyAsync(totalChunks, w.chunkEnds + 2 * items - 1, sizeof(std::uint32_t), cudaMemcpyDeviceToHost, s),
+        "copying the number of chunks");
+}
+
+void
+LaunchSampleTexture(const EvaluationConstants & constants, std::size_t items, void * workspace, std::size_t chunks,
+                    void * chunkWorkspace, double * directionOut, void * stream)
+{
+  if (items == 0)
+    return;
+  const cudaStream_t     s = static_cast<cudaStream_t>(stream);
+  const PrepareWorkspace w = Partition(workspace, items);
+  auto *                 chunkSums = static_cast<double2 *>(chunkWorkspace);
+  auto * chunkTask = reinterpret_cast<std::uint32_t *>(static_cast<unsigned char *>(chunkWorkspace) +
+                                                       Aligned(chunks * sizeof(double2)));
+  const std::size_t tasks = 2 * items;
+  const unsigned    taskBlocks = static_cast<unsigned>((tasks + 255) / 256);
+  ScatterChunkTasks<<<taskBlocks, 256, 0, s>>>(w.chunkCounts, w.chunkEnds, tasks, chunkTask);
+  Check(cudaGetLastError(), "launching the chunk scatter kernel");
+
+  SamplingConstants k;
+  k.movingIntensity = static_cast<cudaTextureObject_t>(constants.packedMoving.intensityTexture);
+  k.fixedIntensity = static_cast<cudaTextureObject_t>(constants.packedFixed.intensityTexture);
+  k.movingDistance = static_cast<cudaTextureObject_t>(constants.packedMoving.distanceTexture);
+  k.fixedDistance = static_cast<cudaTextureObject_t>(constants.packedFixed.distanceTexture);
+  k.distanceChannels = constants.packedMoving.distanceChannels;
+  for (int g = 0; g < 3; ++g)
+    k.guidanceWeights[g] = constants.textureGuidanceWeights[g];
+  k.radius = static_cast<float>(constants.guidanceRadius);
+  k.inverseRadius = static_cast<float>(1.0 / constants.guidanceRadius);
+  k.structures = constants.structures;
+  k.chunkIterations = constants.chunkSamples / 32;
+  if (chunks > 0)
+  {
+    const unsigned sampleBlocks = static_cast<unsigned>((chunks + SampleWarpsPerBlock - 1) / SampleWarpsPerBlock);
+    SampleTextureChunks<<<sampleBlocks, SampleWarpsPerBlock * 32, 0, s>>>(k, w.tasks, w.chunkCounts, w.chunkEnds,
+                                                                          chunkTask, chunks, chunkSums);
+    Check(cudaGetLastError(), "launching the texture sampling kernel");
+  }
+  SumChunks<<<taskBlocks, 256, 0, s>>>(w.tasks, w.chunkCounts, w.chunkEnds, chunkSums, tasks, directionOut);
+  Check(cudaGetLastError(), "launching the chunk sum kernel");
+}
+} // namespace morea::cuda
