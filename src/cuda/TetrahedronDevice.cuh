@@ -52,6 +52,37 @@ SobolShifts(std::uint64_t seed, std::uint32_t shift[4])
   }
 }
 
+/** Sobol state of sample 32 j + lane, split in two. Its Gray code is
+ *  16 (2j ^ j) ^ gray(lane) (XOR is linear and the parts' bits do not
+ *  overlap), so the state is this lane's fixed part XOR a part shared by the
+ *  whole warp. `directions`: the 4 x 32 direction numbers. */
+inline __device__ void
+SobolLaneState(const std::uint32_t shift[4], int lane, const std::uint32_t * directions, std::uint32_t state[4])
+{
+  const std::uint32_t gray = static_cast<std::uint32_t>(lane) ^ (static_cast<std::uint32_t>(lane) >> 1);
+#pragma unroll
+  for (int d = 0; d < 4; ++d)
+  {
+    state[d] = shift[d];
+#pragma unroll
+    for (int b = 0; b < 5; ++b)
+      if ((gray >> b) & 1u)
+        state[d] ^= directions[d * 32 + b];
+  }
+}
+
+/** The warp-shared part of the Sobol state of samples 32 j + lane. */
+inline __device__ void
+SobolWarpPart(std::uint32_t j, const std::uint32_t * directions, std::uint32_t part[4])
+{
+  part[0] = part[1] = part[2] = part[3] = 0;
+  for (std::uint32_t bits = (2 * j) ^ j, b = 4; bits; bits >>= 1, ++b) // warp-uniform loop
+    if (bits & 1u)
+#pragma unroll
+      for (int d = 0; d < 4; ++d)
+        part[d] ^= directions[d * 32 + b];
+}
+
 inline __device__ std::uint64_t
 TetrahedronSeed(const double c[12])
 {

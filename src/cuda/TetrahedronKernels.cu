@@ -21,6 +21,25 @@ __constant__ std::uint32_t c_SobolDirections[4 * 32];
 
 constexpr int WarpsPerBlock = 8;
 
+/** Grid position of `p` (clamped like ChannelVolume::Sample): the first
+ *  corner's index and the fractions. */
+template <typename View>
+__device__ void
+GridPosition(const View & image, const double p[3], int base[3], double f[3])
+{
+  for (int a = 0; a < 3; ++a)
+  {
+    double       x = (p[a] - image.origin[a]) * image.inverseSpacing[a];
+    const double last = static_cast<double>(image.size[a] - 1);
+    x = x < 0.0 ? 0.0 : (x > last ? last : x);
+    double i = floor(x);
+    if (i >= last && image.size[a] > 1)
+      i = last - 1.0;
+    base[a] = static_cast<int>(i);
+    f[a] = image.size[a] > 1 ? x - i : 0.0;
+  }
+}
+
 /** Trilinear interpolation set-up: the first voxel's offset, the channel
  *  strides to the 7 other corners and the 8 weights (ChannelVolume::Sample). */
 struct Trilinear
@@ -34,17 +53,7 @@ struct Trilinear
   {
     int    base[3];
     double f[3];
-    for (int a = 0; a < 3; ++a)
-    {
-      double       x = (p[a] - image.origin[a]) * image.inverseSpacing[a];
-      const double last = static_cast<double>(image.size[a] - 1);
-      x = x < 0.0 ? 0.0 : (x > last ? last : x);
-      double i = floor(x);
-      if (i >= last && image.size[a] > 1)
-        i = last - 1.0;
-      base[a] = static_cast<int>(i);
-      f[a] = image.size[a] > 1 ? x - i : 0.0;
-    }
+    GridPosition(image, p, base, f);
     const int c = image.channels;
     const int sx = image.size[0] > 1 ? c : 0;
     const int sy = image.size[1] > 1 ? c * image.size[0] : 0;
@@ -81,25 +90,6 @@ struct Trilinear
     return static_cast<float>(s);
   }
 };
-
-/** Grid position of `p` (clamped like ChannelVolume::Sample): the first
- *  corner's index and the fractions. */
-template <typename View>
-__device__ void
-GridPosition(const View & image, const double p[3], int base[3], double f[3])
-{
-  for (int a = 0; a < 3; ++a)
-  {
-    double       x = (p[a] - image.origin[a]) * image.inverseSpacing[a];
-    const double last = static_cast<double>(image.size[a] - 1);
-    x = x < 0.0 ? 0.0 : (x > last ? last : x);
-    double i = floor(x);
-    if (i >= last && image.size[a] > 1)
-      i = last - 1.0;
-    base[a] = static_cast<int>(i);
-    f[a] = image.size[a] > 1 ? x - i : 0.0;
-  }
-}
 
 __device__ float
 Component(const float4 & v, int c)
@@ -187,32 +177,13 @@ EvaluateTetrahedraKernel(EvaluationConstants k, View moving, View fixed, const d
 
   const double r = k.guidanceRadius;
   const double inverseRadius = 1.0 / r;
-  // Sample s = 32 j + lane has Gray code gray(s) = 16 (2j ^ j) ^ gray(lane)
-  // (XOR is linear and the parts' bits do not overlap), so its Sobol state is
-  // this lane's fixed part XOR a part shared by the whole warp.
   std::uint32_t laneState[4];
-  {
-    const std::uint32_t gray = static_cast<std::uint32_t>(lane) ^ (static_cast<std::uint32_t>(lane) >> 1);
-#pragma unroll
-    for (int d = 0; d < 4; ++d)
-    {
-      std::uint32_t state = shift[d];
-#pragma unroll
-      for (int b = 0; b < 5; ++b)
-        if ((gray >> b) & 1u)
-          state ^= c_SobolDirections[d * 32 + b];
-      laneState[d] = state;
-    }
-  }
+  SobolLaneState(shift, lane, c_SobolDirections, laneState);
   double intensity = 0.0, guidance = 0.0;
   for (std::uint32_t j = 0; 32 * j < n; ++j)
   {
-    std::uint32_t shared[4] = { 0, 0, 0, 0 };
-    for (std::uint32_t bits = (2 * j) ^ j, b = 4; bits; bits >>= 1, ++b) // warp-uniform loop
-      if (bits & 1u)
-#pragma unroll
-        for (int d = 0; d < 4; ++d)
-          shared[d] ^= c_SobolDirections[d * 32 + b];
+    std::uint32_t shared[4];
+    SobolWarpPart(j, c_SobolDirections, shared);
     if (32 * j + lane >= n)
       break;
     // Barycentric weights -log(u) in single precision: the samples' positions

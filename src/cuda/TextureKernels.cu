@@ -250,27 +250,16 @@ SampleTextureChunks(SamplingConstants k, const SampleTask * __restrict__ tasks,
   const cudaTextureObject_t fromDistance = direction == 0 ? k.movingDistance : k.fixedDistance;
   const cudaTextureObject_t toDistance = direction == 0 ? k.fixedDistance : k.movingDistance;
 
-  // Sample 32 j + lane: this lane's fixed part of the Sobol state XOR a part
-  // shared by the warp (see TetrahedronKernels.cu).
-  const std::uint32_t gray = static_cast<std::uint32_t>(lane) ^ (static_cast<std::uint32_t>(lane) >> 1);
-  std::uint32_t       laneState[4] = { shift.x, shift.y, shift.z, shift.w };
-#pragma unroll
-  for (int d = 0; d < 4; ++d)
-#pragma unroll
-    for (int b = 0; b < 5; ++b)
-      if ((gray >> b) & 1u)
-        laneState[d] ^= c_SobolDirections[d * 32 + b];
+  const std::uint32_t shifts[4] = { shift.x, shift.y, shift.z, shift.w };
+  std::uint32_t       laneState[4];
+  SobolLaneState(shifts, lane, c_SobolDirections, laneState);
 
   float               intensity = 0.0f, guidance = 0.0f;
   const std::uint32_t firstJ = local * k.chunkIterations;
   for (std::uint32_t j = firstJ; j < firstJ + k.chunkIterations && 32 * j < n; ++j)
   {
-    std::uint32_t shared[4] = { 0, 0, 0, 0 };
-    for (std::uint32_t bits = (2 * j) ^ j, b = 4; bits; bits >>= 1, ++b) // warp-uniform loop
-      if (bits & 1u)
-#pragma unroll
-        for (int d = 0; d < 4; ++d)
-          shared[d] ^= c_SobolDirections[d * 32 + b];
+    std::uint32_t shared[4];
+    SobolWarpPart(j, c_SobolDirections, shared);
     if (32 * j + lane >= n)
       break;
     float w[4], sum = 0.0f;
