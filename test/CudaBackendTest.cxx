@@ -349,3 +349,49 @@ TEST(EvaluationBackendSelection, NamesAndDeviceAbsence)
     EXPECT_EQ(CreateEvaluationBackend(BackendChoice::CudaTexture, *problem.evaluator, 1)->Name(), "cuda-texture");
   }
 }
+
+TEST(CudaEvaluationBackend, FoldChecksAndRepairAgreeWithTheCpu)
+{
+  MOREA_REQUIRE_CUDA_DEVICE();
+  OptimiserTestProblem problem;
+  const auto           population = problem.InitialPopulation(problem.Options());
+  const std::vector<DualMesh> parents(population.begin(), population.begin() + 8);
+  for (bool repair : { true, false })
+    for (std::size_t g = 0; g < 2; ++g)
+    {
+      const auto & group = problem.parallel.groups[g];
+      const std::string what = (repair ? "repair, group " : "check only, group ") + std::to_string(g);
+      morea_test::RandomCandidates onCpu(problem, parents, group, 4.0, 31 + g);
+      morea_test::RandomCandidates onGpu(problem, parents, group, 4.0, 31 + g);
+      FoldHandling                 handling;
+      handling.constraint = problem.constraint.get();
+      handling.base = &problem.base;
+      handling.repair = repair;
+      auto cpu = CreateCpuEvaluationBackend(*problem.evaluator, 2);
+      auto cuda = CreateCudaEvaluationBackend(*problem.evaluator, 2);
+      cpu->SetFoldHandling(handling);
+      cuda->SetFoldHandling(handling);
+      cpu->EvaluatePartials(onCpu.candidates);
+      cuda->EvaluatePartials(onGpu.candidates);
+      EXPECT_GT(cuda->Statistics().foldSeconds, 0.0);
+      std::size_t folded = 0, repaired = 0;
+      for (std::size_t i = 0; i < onCpu.candidates.size(); ++i)
+      {
+        EXPECT_EQ(onCpu.folds[i].foldedSides, onGpu.folds[i].foldedSides) << what << " candidate " << i;
+        EXPECT_EQ(onCpu.folds[i].repairedSides, onGpu.folds[i].repairedSides) << what << " candidate " << i;
+        folded += onCpu.folds[i].foldedSides;
+        repaired += onCpu.folds[i].repairedSides;
+        // The same moves (RepairNoise.h), rounded the same way: the same
+        // bits (they seed the tetrahedra's samples).
+        EXPECT_EQ(onCpu.source[i], onGpu.source[i]) << what << " candidate " << i;
+        EXPECT_EQ(onCpu.target[i], onGpu.target[i]) << what << " candidate " << i;
+        if (!onCpu.folds[i].Folded())
+          ExpectSameTotals(onCpu.values[i], onGpu.values[i], what + " candidate " + std::to_string(i), 1e-6);
+      }
+      EXPECT_GT(folded, 10u) << what;
+      if (repair)
+        EXPECT_GT(repaired, folded / 2) << what;
+      else
+        EXPECT_EQ(repaired, 0u) << what;
+    }
+}

@@ -45,6 +45,12 @@ public:
     std::shuffle(shuffled.begin(), shuffled.end(), m_Random);
     m_Cpu->EvaluatePartials(shuffled);
   }
+  void
+  SetFoldHandling(const FoldHandling & handling) override
+  {
+    EvaluationBackend::SetFoldHandling(handling);
+    m_Cpu->SetFoldHandling(handling);
+  }
 
 private:
   std::unique_ptr<EvaluationBackend> m_Cpu;

@@ -13,6 +13,7 @@
 #include "morea/MoRvGomea.h"
 #include "morea/ObjectiveData.h"
 #include "morea/ParallelStructure.h"
+#include "morea/Random.h"
 #include "morea/TetrahedronObjectives.h"
 
 #include <cmath>
@@ -103,6 +104,72 @@ struct OptimiserTestProblem
   InitialPopulation(const morea::GomeaOptions & o) const
   {
     return morea::GenerateInitialPopulation(base, *constraint, o.populationSize, o.seed);
+  }
+};
+
+/** Partial candidates of every element of `group` for each parent, their
+ *  points moved by Gaussian steps of `sigma` mm per coordinate and kept in the
+ *  domain, as the optimiser samples them; owns positions and outputs (the
+ *  candidates point into it, so it is neither copied nor moved). */
+struct RandomCandidates
+{
+  std::vector<std::vector<morea::Vec3>>              source, target;
+  std::vector<std::vector<morea::TetrahedronValues>> values;
+  std::vector<morea::CandidateFolds>                 folds;
+  std::vector<morea::PartialCandidate>               candidates;
+
+  RandomCandidates(const OptimiserTestProblem & problem, const std::vector<morea::DualMesh> & parents,
+                   const std::vector<std::uint32_t> & group, double sigma, std::uint64_t seed)
+  {
+    morea::RandomGenerator random(seed);
+    for (const morea::DualMesh & parent : parents)
+      for (std::uint32_t e : group)
+      {
+        const morea::FosElement & element = problem.parallel.elements[e];
+        std::vector<morea::Vec3>  s, t;
+        for (std::uint32_t p : element.points)
+        {
+          morea::Vec3 a = parent.source[p], b = parent.target[p];
+          for (int axis = 0; axis < 3; ++axis)
+          {
+            a[axis] += sigma * random.Normal();
+            b[axis] += sigma * random.Normal();
+          }
+          s.push_back(morea::ProjectToDomain(a, problem.base.pins[p], problem.base.domain));
+          t.push_back(morea::ProjectToDomain(b, problem.base.pins[p], problem.base.domain));
+        }
+        source.push_back(std::move(s));
+        target.push_back(std::move(t));
+        values.emplace_back(element.dependentTetrahedra.size());
+        morea::PartialCandidate c;
+        c.parent = &parent;
+        c.element = &element;
+        c.seed = random.NextU64();
+        candidates.push_back(c);
+      }
+    folds.resize(candidates.size());
+    for (std::size_t i = 0; i < candidates.size(); ++i)
+    {
+      candidates[i].source = source[i].data();
+      candidates[i].target = target[i].data();
+      candidates[i].values = values[i].data();
+      candidates[i].folds = &folds[i];
+    }
+  }
+  RandomCandidates(const RandomCandidates &) = delete;
+  RandomCandidates &
+  operator=(const RandomCandidates &) = delete;
+
+  /** One side of candidate i as a whole mesh side: the parent's points with
+   *  the element's replaced. */
+  std::vector<morea::Vec3>
+  Side(std::size_t i, int side) const
+  {
+    const morea::PartialCandidate & c = candidates[i];
+    std::vector<morea::Vec3>        points = side == 0 ? c.parent->source : c.parent->target;
+    for (std::size_t k = 0; k < c.element->points.size(); ++k)
+      points[c.element->points[k]] = side == 0 ? c.source[k] : c.target[k];
+    return points;
   }
 };
 } // namespace morea_test

@@ -203,3 +203,85 @@ TEST(CpuEvaluationBackend, BatchResultDoesNotDependOnOrderOrThreads)
       EXPECT_EQ(one[j][k].magnitude, two[j][k].magnitude);
     }
 }
+
+TEST(CpuEvaluationBackend, FoldChecksRepairCandidatesInPlace)
+{
+  OptimiserTestProblem problem;
+  const auto           population = problem.InitialPopulation(problem.Options());
+  const std::vector<DualMesh> parents(population.begin(), population.begin() + 8);
+  const auto &                group = problem.parallel.groups[0];
+  // Steps of about a cell's half width: many candidates fold.
+  morea_test::RandomCandidates sampled(problem, parents, group, 4.0, 21);
+  morea_test::RandomCandidates repaired(problem, parents, group, 4.0, 21);
+  morea_test::RandomCandidates again(problem, parents, group, 4.0, 21);
+  for (auto & c : repaired.candidates)
+    c.evaluateFolded = false;
+
+  FoldHandling handling;
+  handling.constraint = problem.constraint.get();
+  handling.base = &problem.base;
+  handling.repair = true;
+  auto backend = CreateCpuEvaluationBackend(*problem.evaluator, 1);
+  backend->SetFoldHandling(handling);
+  backend->EvaluatePartials(repaired.candidates);
+  EXPECT_GT(backend->Statistics().foldSeconds, 0.0);
+
+  std::size_t foldedSides = 0, repairedSides = 0, stillFolded = 0;
+  for (std::size_t i = 0; i < sampled.candidates.size(); ++i)
+  {
+    const auto & dependent = sampled.candidates[i].element->dependentTetrahedra;
+    std::uint8_t folded = 0;
+    for (int side = 0; side < 2; ++side)
+    {
+      const bool before = !problem.constraint->Partial(sampled.Side(i, side), dependent).Feasible();
+      const bool after = !problem.constraint->Partial(repaired.Side(i, side), dependent).Feasible();
+      folded += before;
+      if (!before)
+        EXPECT_EQ(sampled.Side(i, side), repaired.Side(i, side)) << "an unfolded side is left alone, candidate " << i;
+      else if (!after)
+        ++repairedSides;
+    }
+    EXPECT_EQ(repaired.folds[i].foldedSides, folded) << "candidate " << i;
+    foldedSides += folded;
+    stillFolded += repaired.folds[i].Folded();
+  }
+  EXPECT_GT(foldedSides, 10u);
+  EXPECT_GT(repairedSides, foldedSides / 2) << "most folds are repaired";
+  std::size_t reported = 0;
+  for (const auto & f : repaired.folds)
+    reported += f.repairedSides;
+  EXPECT_EQ(reported, repairedSides);
+
+  // Without fold handling, the repaired candidates evaluate to the same values;
+  // the still folded ones (evaluateFolded false) were skipped.
+  std::vector<std::vector<TetrahedronValues>> plain(repaired.values.size());
+  std::vector<PartialCandidate>               batch = repaired.candidates;
+  for (std::size_t i = 0; i < batch.size(); ++i)
+  {
+    plain[i].resize(repaired.values[i].size());
+    batch[i].values = plain[i].data();
+    batch[i].folds = nullptr;
+  }
+  CreateCpuEvaluationBackend(*problem.evaluator, 2)->EvaluatePartials(batch);
+  for (std::size_t i = 0; i < batch.size(); ++i)
+  {
+    if (repaired.folds[i].Folded())
+      continue;
+    for (std::size_t k = 0; k < plain[i].size(); ++k)
+    {
+      EXPECT_EQ(plain[i][k].intensity, repaired.values[i][k].intensity);
+      EXPECT_EQ(plain[i][k].folded, 0.0);
+    }
+  }
+
+  // The repair is a function of the candidate's seed: other threads, same points.
+  auto other = CreateCpuEvaluationBackend(*problem.evaluator, 3);
+  other->SetFoldHandling(handling);
+  other->EvaluatePartials(again.candidates);
+  for (std::size_t i = 0; i < again.candidates.size(); ++i)
+  {
+    EXPECT_EQ(again.source[i], repaired.source[i]);
+    EXPECT_EQ(again.target[i], repaired.target[i]);
+  }
+  EXPECT_LT(stillFolded, foldedSides);
+}

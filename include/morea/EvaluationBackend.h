@@ -6,6 +6,7 @@
 #ifndef morea_EvaluationBackend_h
 #define morea_EvaluationBackend_h
 
+#include "morea/MeshRepair.h"
 #include "morea/ParallelStructure.h"
 #include "morea/TetrahedronObjectives.h"
 
@@ -17,15 +18,50 @@
 
 namespace morea
 {
+/** What the fold check found on a candidate's two sides (source, target). */
+struct CandidateFolds
+{
+  std::uint8_t foldedSides{ 0 };   ///< sides folded as sampled
+  std::uint8_t repairedSides{ 0 }; ///< of those, fold-free after the repair
+
+  bool
+  Folded() const
+  {
+    return repairedSides < foldedSides;
+  }
+};
+
 /** A parent solution with the points of one FOS element moved. */
 struct PartialCandidate
 {
   const DualMesh *   parent{ nullptr };
   const FosElement * element{ nullptr };
-  const Vec3 *       source{ nullptr }; ///< new source positions, one per element point
-  const Vec3 *       target{ nullptr }; ///< new target positions, one per element point
+  /** New positions, one per element point; a fold repair rewrites them. */
+  Vec3 * source{ nullptr };
+  Vec3 * target{ nullptr };
   /** Output: one entry per element->dependentTetrahedra, in that order. */
   TetrahedronValues * values{ nullptr };
+  /** Output of the fold check (see FoldHandling); null: no check. */
+  CandidateFolds * folds{ nullptr };
+  /** Seeds the repair's moves: side s (0 source, 1 target) repairs with
+   *  HashCombine(seed, s). */
+  std::uint64_t seed{ 0 };
+  /** False: a candidate still folded after its repair gets no values (its
+   *  parent is fold-free, so it cannot replace it). */
+  bool evaluateFolded{ true };
+};
+
+/** How EvaluatePartials treats folds (SPEC 5). Each side of a candidate with
+ *  `folds` set is checked over the element's dependent tetrahedra before it is
+ *  evaluated; with `repair`, a folded side is repaired as RepairPoints does
+ *  (only the element's points move), in place. Done by the backend so that a
+ *  GPU checks and repairs the batch where its points already are. */
+struct FoldHandling
+{
+  const FoldConstraint *  constraint{ nullptr }; ///< null: no checks
+  const TetrahedralMesh * base{ nullptr };       ///< pins and domain of the repair's moves
+  bool                    repair{ false };
+  RepairOptions           options;
 };
 
 /** Work a backend has done since it was made (for benchmarks and logs). */
@@ -36,6 +72,7 @@ struct BackendStatistics
   double        samples{ 0.0 };     ///< sample points drawn, both directions
   double        seconds{ 0.0 };     ///< wall time inside the calls
   double        kernelSeconds{ 0.0 }; ///< device time of the kernels (CUDA only)
+  double        foldSeconds{ 0.0 };   ///< of the calls' time, fold checks and repair (CUDA: device time)
 };
 
 class EvaluationBackend
@@ -59,13 +96,34 @@ public:
   EvaluateSolutions(const std::vector<const DualMesh *> & solutions,
                     const std::vector<std::vector<TetrahedronValues> *> & values) = 0;
 
-  /** The dependent tetrahedra of every candidate, each with its moved points. */
+  /** The dependent tetrahedra of every candidate, each with its moved points;
+   *  fold checks first where asked for (SetFoldHandling). */
   virtual void
   EvaluatePartials(const std::vector<PartialCandidate> & candidates) = 0;
 
+  /** Fold checks and repair of later EvaluatePartials calls; the constraint
+   *  and base mesh must outlive them. */
+  virtual void
+  SetFoldHandling(const FoldHandling & handling)
+  {
+    m_FoldHandling = handling;
+  }
+  const FoldHandling &
+  GetFoldHandling() const
+  {
+    return m_FoldHandling;
+  }
+
 protected:
   BackendStatistics m_Statistics;
+  FoldHandling      m_FoldHandling;
 };
+
+/** The fold check (and repair) of one candidate, as the CPU backend does it:
+ *  the reference for other backends. Rewrites the candidate's points where a
+ *  side is repaired. */
+CandidateFolds
+CheckCandidateFolds(const PartialCandidate & candidate, const FoldHandling & handling);
 
 /** The CPU backend over `threads` threads (0: all hardware threads). */
 std::unique_ptr<EvaluationBackend>

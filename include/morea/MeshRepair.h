@@ -47,11 +47,14 @@ RepairFolds(std::vector<Vec3> & points, const TetrahedralMesh & base, const Fold
  *  at the tetrahedra in `scope` (null: all; it must hold every tetrahedron of
  *  the movable points). A variation step repairs only the points it moved
  *  within its dependent tetrahedra, so that candidates of one parallel group
- *  stay independent; before/after then count the scope only. */
+ *  stay independent; before/after then count the scope only. The moves come
+ *  from RepairTrialNormals(seed, ...): points are visited in ascending index
+ *  and the first trial with the lowest (violation, folded count) wins, so a
+ *  parallel implementation can reproduce the repair. */
 RepairResult
 RepairPoints(std::vector<Vec3> & points, const std::vector<std::uint32_t> * movable,
              const std::vector<std::uint32_t> * scope, const TetrahedralMesh & base, const FoldConstraint & constraint,
-             RandomGenerator & random, const RepairOptions & options = {});
+             std::uint64_t seed, const RepairOptions & options = {});
 /** Both meshes of a solution. */
 RepairResult
 RepairFolds(DualMesh & solution, const TetrahedralMesh & base, const FoldConstraint & constraint,

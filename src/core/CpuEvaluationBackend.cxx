@@ -4,6 +4,7 @@
 #include "morea/EvaluationBackend.h"
 
 #include "morea/Error.h"
+#include "morea/Random.h"
 #include "morea/ThreadPool.h"
 
 #include <algorithm>
@@ -29,6 +30,49 @@ CandidateCorners(const PartialCandidate & c, const Tetrahedron & t, Corners & so
 {
   source = CornersWithReplacedPoints(t, c.parent->source, c.element->points, c.source);
   target = CornersWithReplacedPoints(t, c.parent->target, c.element->points, c.target);
+}
+
+CandidateFolds
+CheckCandidateFolds(const PartialCandidate & c, const FoldHandling & handling)
+{
+  CandidateFolds result;
+  if (!handling.constraint)
+    return result;
+  const FoldConstraint & constraint = *handling.constraint;
+  const auto &           tets = constraint.Topology().Tetrahedra();
+  const FosElement &     element = *c.element;
+  std::vector<Vec3>      scratch;
+  for (int side = 0; side < 2; ++side)
+  {
+    const std::vector<Vec3> & from = side == 0 ? c.parent->source : c.parent->target;
+    Vec3 *                    moved = side == 0 ? c.source : c.target;
+    bool                      folded = false;
+    for (std::uint32_t t : element.dependentTetrahedra)
+    {
+      const Corners corners = CornersWithReplacedPoints(tets[t], from, element.points, moved);
+      constraint.TetrahedronViolation(t, corners[0], corners[1], corners[2], corners[3], folded);
+      if (folded)
+        break;
+    }
+    if (!folded)
+      continue;
+    ++result.foldedSides;
+    if (!handling.repair)
+      continue;
+    if (!handling.base)
+      throw Error("evaluation backend: the fold repair needs the base mesh");
+    scratch = from;
+    for (std::size_t k = 0; k < element.points.size(); ++k)
+      scratch[element.points[k]] = moved[k];
+    const RepairResult r = RepairPoints(scratch, &element.points, &element.dependentTetrahedra, *handling.base,
+                                        constraint, HashCombine(c.seed, static_cast<std::uint64_t>(side)),
+                                        handling.options);
+    for (std::size_t k = 0; k < element.points.size(); ++k)
+      moved[k] = scratch[element.points[k]];
+    if (r.after.Feasible())
+      ++result.repairedSides;
+  }
+  return result;
 }
 
 namespace
@@ -84,8 +128,22 @@ public:
   {
     const auto   start = std::chrono::steady_clock::now();
     const auto & tets = m_Evaluator.Topology().Tetrahedra();
+    std::vector<std::uint8_t> skip(candidates.size(), 0);
+    if (m_FoldHandling.constraint)
+    {
+      m_Pool.ParallelFor(candidates.size(), [&](std::size_t i) {
+        const PartialCandidate & c = candidates[i];
+        if (!c.folds)
+          return;
+        *c.folds = CheckCandidateFolds(c, m_FoldHandling);
+        skip[i] = c.folds->Folded() && !c.evaluateFolded;
+      });
+      m_Statistics.foldSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    }
     m_Pool.ParallelFor(candidates.size(), [&](std::size_t i) {
       const PartialCandidate & c = candidates[i];
+      if (skip[i])
+        return;
       Corners                  source, target;
       const auto &             dependent = c.element->dependentTetrahedra;
       for (std::size_t k = 0; k < dependent.size(); ++k)
@@ -95,8 +153,11 @@ public:
       }
     });
     ++m_Statistics.batches;
-    for (const PartialCandidate & c : candidates)
+    for (std::size_t i = 0; i < candidates.size(); ++i)
     {
+      const PartialCandidate & c = candidates[i];
+      if (skip[i])
+        continue;
       m_Statistics.tetrahedra += c.element->dependentTetrahedra.size();
       for (std::size_t k = 0; k < c.element->dependentTetrahedra.size(); ++k)
         m_Statistics.samples += c.values[k].samples;

@@ -1,5 +1,7 @@
 #include "morea/MeshRepair.h"
 
+#include "morea/RepairNoise.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -65,13 +67,13 @@ RepairResult
 RepairFolds(std::vector<Vec3> & points, const TetrahedralMesh & base, const FoldConstraint & constraint,
             RandomGenerator & random, const RepairOptions & options)
 {
-  return RepairPoints(points, nullptr, nullptr, base, constraint, random, options);
+  return RepairPoints(points, nullptr, nullptr, base, constraint, random.NextU64(), options);
 }
 
 RepairResult
 RepairPoints(std::vector<Vec3> & points, const std::vector<std::uint32_t> * movable,
              const std::vector<std::uint32_t> * scope, const TetrahedralMesh & base, const FoldConstraint & constraint,
-             RandomGenerator & random, const RepairOptions & options)
+             std::uint64_t seed, const RepairOptions & options)
 {
   const MeshTopology & topology = constraint.Topology();
   auto evaluate = [&] { return scope ? constraint.Partial(points, *scope) : constraint.Evaluate(points); };
@@ -126,8 +128,10 @@ RepairPoints(std::vector<Vec3> & points, const std::vector<std::uint32_t> * mova
       FoldViolation best = current;
       for (std::size_t s = 0; s < options.samplesPerPoint; ++s)
       {
-        const Vec3 trial{ { original[0] + scale * random.Normal(), original[1] + scale * random.Normal(),
-                            original[2] + scale * random.Normal() } };
+        double move[3];
+        RepairTrialNormals(seed, static_cast<std::uint32_t>(round), p, static_cast<std::uint32_t>(s), move);
+        const Vec3 trial{ { original[0] + scale * move[0], original[1] + scale * move[1],
+                            original[2] + scale * move[2] } };
         points[p] = ProjectToDomain(trial, pin, base.domain);
         FoldViolation v;
         if (BoundedViolation(constraint, points, localBegin, localEnd, best.value, v) && Better(v, best))

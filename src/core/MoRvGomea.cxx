@@ -191,6 +191,11 @@ MoRvGomea::MoRvGomea(const TetrahedralMesh & base, const MeshTopology & topology
     throw Error("optimiser: the mesh has no FOS elements");
   m_Archive = std::make_unique<ElitistArchive>(options.archiveCapacity);
   m_Pool = std::make_unique<ThreadPool>(options.threads);
+  FoldHandling folds;
+  folds.constraint = &m_Constraint;
+  folds.base = &m_Base;
+  folds.repair = options.repair;
+  m_Backend.SetFoldHandling(folds);
 }
 
 MoRvGomea::~MoRvGomea() = default;
@@ -619,82 +624,48 @@ MoRvGomea::SampleCandidates(std::vector<Candidate> & candidates, const ClusterMo
 std::size_t
 MoRvGomea::ProcessCandidates(std::vector<Candidate> & candidates, GenerationRecord & record)
 {
-  const auto &   tets = m_Topology.Tetrahedra();
-  RepairOptions  repairOptions;
-  // 1. Folds: checked (and repaired) before any costly evaluation; a folded
-  //    candidate cannot replace a fold-free parent. Candidates are
-  //    independent here (each repair has its own random stream), so they are
-  //    checked in parallel and gathered in order afterwards.
-  auto                      phaseStart = std::chrono::steady_clock::now();
-  std::vector<std::uint8_t> foldedSides(candidates.size(), 0);
-  std::vector<std::uint8_t> repairedSides(candidates.size(), 0);
-  m_Pool->ParallelFor(candidates.size(), [&](std::size_t i) {
-    Candidate &        c = candidates[i];
-    const FosElement & element = m_Parallel.elements[c.element];
-    const DualMesh &   parent = m_Population[c.solution];
-    std::vector<Vec3>  scratch;
-    for (int side = 0; side < 2; ++side)
-    {
-      const std::vector<Vec3> & from = side == 0 ? parent.source : parent.target;
-      std::vector<Vec3> &       moved = side == 0 ? c.source : c.target;
-      bool                      folded = false;
-      for (std::uint32_t t : element.dependentTetrahedra)
-      {
-        const Corners corners = CornersWithReplacedPoints(tets[t], from, element.points, moved.data());
-        m_Constraint.TetrahedronViolation(t, corners[0], corners[1], corners[2], corners[3], folded);
-        if (folded)
-          break;
-      }
-      if (folded && !c.folded)
-        foldedSides[i] += 1;
-      if (folded && m_Options.repair)
-      {
-        scratch = from;
-        for (std::size_t k = 0; k < element.points.size(); ++k)
-          scratch[element.points[k]] = moved[k];
-        RandomGenerator random(HashCombine(c.seed, static_cast<std::uint64_t>(side)));
-        const RepairResult r =
-          RepairPoints(scratch, &element.points, &element.dependentTetrahedra, m_Base, m_Constraint, random, repairOptions);
-        for (std::size_t k = 0; k < element.points.size(); ++k)
-          moved[k] = scratch[element.points[k]];
-        folded = !r.after.Feasible();
-        if (!folded)
-          repairedSides[i] += 1;
-      }
-      c.folded = c.folded || folded;
-    }
-  });
-
-  std::vector<PartialCandidate> batch;
-  std::vector<std::size_t>      batchIndex;
+  // 1. Fold checks (and repair) and evaluation of the whole batch at once,
+  //    in the backend (the GPU checks where the points already are). A
+  //    candidate still folded cannot replace a fold-free parent: it needs no
+  //    values then.
+  std::vector<PartialCandidate> batch(candidates.size());
+  std::vector<CandidateFolds>   folds(candidates.size());
   for (std::size_t i = 0; i < candidates.size(); ++i)
   {
     Candidate &        c = candidates[i];
     const FosElement & element = m_Parallel.elements[c.element];
-    ++record.candidates;
-    record.folded += foldedSides[i];
-    record.repaired += repairedSides[i];
-    if (c.folded && std::llround(m_Totals[c.solution].sum.folded) == 0)
-      continue;
-    PartialCandidate p;
+    c.values.resize(element.dependentTetrahedra.size());
+    PartialCandidate & p = batch[i];
     p.parent = &m_Population[c.solution];
     p.element = &element;
     p.source = c.source.data();
     p.target = c.target.data();
-    c.values.resize(element.dependentTetrahedra.size());
     p.values = c.values.data();
-    batch.push_back(p);
-    batchIndex.push_back(i);
-    record.tetrahedronEvaluations += static_cast<double>(element.dependentTetrahedra.size());
+    p.folds = &folds[i];
+    p.seed = c.seed;
+    p.evaluateFolded = std::llround(m_Totals[c.solution].sum.folded) != 0;
   }
-
-  record.phaseSeconds.foldChecks += SecondsSince(phaseStart);
-
-  // 2. Evaluation of the whole batch at once (the backend's unit of work).
-  phaseStart = std::chrono::steady_clock::now();
+  const BackendStatistics before = m_Backend.Statistics();
+  auto                    phaseStart = std::chrono::steady_clock::now();
   m_Backend.EvaluatePartials(batch);
-  record.phaseSeconds.evaluation += SecondsSince(phaseStart);
+  const double foldSeconds = m_Backend.Statistics().foldSeconds - before.foldSeconds;
+  record.phaseSeconds.foldChecks += foldSeconds;
+  record.phaseSeconds.evaluation += SecondsSince(phaseStart) - foldSeconds;
   phaseStart = std::chrono::steady_clock::now();
+
+  std::vector<std::size_t> batchIndex;
+  for (std::size_t i = 0; i < candidates.size(); ++i)
+  {
+    Candidate & c = candidates[i];
+    ++record.candidates;
+    record.folded += folds[i].foldedSides;
+    record.repaired += folds[i].repairedSides;
+    c.folded = folds[i].Folded();
+    if (c.folded && !batch[i].evaluateFolded)
+      continue;
+    batchIndex.push_back(i);
+    record.tetrahedronEvaluations += static_cast<double>(m_Parallel.elements[c.element].dependentTetrahedra.size());
+  }
 
   // 3. Acceptance in a fixed order; candidates of one solution touch disjoint
   //    tetrahedra, so each one's change of the totals does not depend on the

@@ -8,10 +8,12 @@
 #include "morea/EvaluationBackend.h"
 
 #include "DeviceMemory.h"
+#include "FoldRepairKernels.h"
 #include "TetrahedronKernels.h"
 
 #include "morea/ComputeDevices.h"
 #include "morea/Error.h"
+#include "morea/Random.h"
 #include "morea/TetrahedronSampling.h"
 #include "morea/ThreadPool.h"
 
@@ -47,6 +49,8 @@ public:
     m_Stream = std::make_unique<cuda::Stream>();
     m_KernelStart = std::make_unique<cuda::Event>();
     m_KernelEnd = std::make_unique<cuda::Event>();
+    m_FoldStart = std::make_unique<cuda::Event>();
+    m_FoldEnd = std::make_unique<cuda::Event>();
     m_HostChunks.Reserve(1);
     cuda::UploadSobolDirections(SobolDirectionNumbers());
 
@@ -120,16 +124,67 @@ public:
   }
 
   void
+  SetFoldHandling(const FoldHandling & handling) override
+  {
+    if (handling.repair && !handling.base)
+      throw Error("evaluation backend: the fold repair needs the base mesh");
+    EvaluationBackend::SetFoldHandling(handling);
+    if (!handling.constraint)
+      return;
+    const FoldConstraint & constraint = *handling.constraint;
+    const MeshTopology &   topology = constraint.Topology();
+    if (topology.NumberOfPoints() != m_Batch.points)
+      throw Error("evaluation backend: the fold constraint's mesh is not the evaluator's");
+    std::vector<std::uint32_t> offsets{ 0 }, pointTetrahedra;
+    for (std::size_t p = 0; p < topology.NumberOfPoints(); ++p)
+    {
+      pointTetrahedra.insert(pointTetrahedra.end(), topology.TetrahedraOfPointBegin(p), topology.TetrahedraOfPointEnd(p));
+      offsets.push_back(static_cast<std::uint32_t>(pointTetrahedra.size()));
+    }
+    std::vector<std::int8_t> pins(3 * topology.NumberOfPoints(), 0);
+    if (handling.base)
+    {
+      if (handling.base->pins.size() != topology.NumberOfPoints())
+        throw Error("evaluation backend: the base mesh does not match the fold constraint's");
+      for (std::size_t p = 0; p < handling.base->pins.size(); ++p)
+        std::copy(handling.base->pins[p].begin(), handling.base->pins[p].end(), pins.begin() + 3 * p);
+      for (int a = 0; a < 3; ++a)
+      {
+        m_Folds.lower[a] = handling.base->domain.lower[a];
+        m_Folds.upper[a] = handling.base->domain.upper[a];
+      }
+    }
+    m_Folds.referenceVolumes = Upload(constraint.ReferenceVolumes(), m_FoldReferenceVolumes);
+    m_Folds.volumeFraction = constraint.VolumeFraction();
+    m_Folds.pointTetrahedronOffsets = Upload(offsets, m_PointTetrahedronOffsets);
+    m_Folds.pointTetrahedra = Upload(pointTetrahedra, m_PointTetrahedra);
+    m_Folds.pins = Upload(pins, m_Pins);
+    m_Folds.repair = handling.repair;
+    m_Folds.samplesPerPoint = static_cast<std::uint32_t>(handling.options.samplesPerPoint);
+    m_Folds.maxRounds = static_cast<std::uint32_t>(handling.options.maxRounds);
+    Check(cudaStreamSynchronize(m_Stream->Get()), "uploading the fold constraint");
+  }
+
+  void
   EvaluatePartials(const std::vector<PartialCandidate> & candidates) override
   {
     const auto  start = std::chrono::steady_clock::now();
     const auto  items = UploadCandidates(candidates);
+    const bool  checks = items > 0 && StageFoldChecks(candidates);
+    if (checks)
+      LaunchFoldChecks(candidates.size());
     if (items > 0)
     {
       Reserve(items);
       cuda::LaunchGatherCandidateCorners(m_Batch, items, m_Corners.Data(), m_Tetrahedra.Data(), m_Stream->Get());
     }
     Run(items);
+    if (checks)
+      ReadFoldChecks(candidates);
+    else
+      for (const PartialCandidate & c : candidates)
+        if (c.folds)
+          *c.folds = CandidateFolds{}; // no dependent tetrahedra, nothing checked
     std::vector<std::size_t> first(candidates.size() + 1, 0);
     for (std::size_t i = 0; i < candidates.size(); ++i)
       first[i + 1] = first[i] + candidates[i].element->dependentTetrahedra.size();
@@ -279,8 +334,91 @@ private:
     m_Batch.candidateMoved = StageAndUpload(candidateMoved, m_HostCandidateMoved, m_CandidateMoved);
     m_Batch.candidateFirstItem = StageAndUpload(firstItem, m_HostFirstItem, m_FirstItem);
     m_Batch.moved = StageAndUpload(moved, m_HostMoved, m_Moved);
+    m_MovedCount = moved.size();
     m_Batch.candidates = candidates.size();
     return items;
+  }
+
+  /** Stages which candidates are checked and their sides' seeds; false
+   *  when no candidate of the batch asks for a check. */
+  bool
+  StageFoldChecks(const std::vector<PartialCandidate> & candidates)
+  {
+    if (!m_FoldHandling.constraint)
+      return false;
+    std::vector<std::uint8_t>  check(candidates.size(), 0);
+    std::vector<std::uint64_t> seeds(2 * candidates.size(), 0);
+    bool                       any = false;
+    for (std::size_t i = 0; i < candidates.size(); ++i)
+    {
+      const PartialCandidate & c = candidates[i];
+      if (!c.folds)
+        continue;
+      if (c.element->points.size() > cuda::MaxRepairElementPoints)
+        throw Error("CUDA backend: fold checks handle elements of up to " +
+                    std::to_string(cuda::MaxRepairElementPoints) + " points, not " +
+                    std::to_string(c.element->points.size()));
+      check[i] = 1;
+      seeds[2 * i] = HashCombine(c.seed, 0);
+      seeds[2 * i + 1] = HashCombine(c.seed, 1);
+      any = true;
+    }
+    if (!any)
+      return false;
+    m_FoldCheck = StageAndUpload(check, m_HostFoldCheck, m_FoldCheckDevice);
+    m_SideSeeds = StageAndUpload(seeds, m_HostSideSeeds, m_SideSeedsDevice);
+    return true;
+  }
+
+  /** The fold kernel, then its outcome and the repaired points back to the
+   *  host on the stream (read after the evaluation's synchronisation). */
+  void
+  LaunchFoldChecks(std::size_t candidates)
+  {
+    cudaStream_t stream = m_Stream->Get();
+    m_Outcome.Reserve(2 * candidates);
+    m_HostOutcome.Reserve(2 * candidates);
+    Check(cudaEventRecord(m_FoldStart->Get(), stream), "recording an event");
+    cuda::LaunchCheckCandidateFolds(m_Batch, m_Folds, m_FoldCheck, m_SideSeeds, m_Moved.Data(), m_Outcome.Data(),
+                                    stream);
+    Check(cudaEventRecord(m_FoldEnd->Get(), stream), "recording an event");
+    Check(cudaMemcpyAsync(m_HostOutcome.Data(), m_Outcome.Data(), 2 * candidates, cudaMemcpyDeviceToHost, stream),
+          "copying fold checks from the device");
+    if (m_Folds.repair)
+      Check(cudaMemcpyAsync(m_HostMoved.Data(), m_Moved.Data(), m_MovedCount * sizeof(double),
+                            cudaMemcpyDeviceToHost, stream),
+            "copying repaired points from the device");
+  }
+
+  void
+  ReadFoldChecks(const std::vector<PartialCandidate> & candidates)
+  {
+    float milliseconds = 0.0f;
+    Check(cudaEventElapsedTime(&milliseconds, m_FoldStart->Get(), m_FoldEnd->Get()), "reading an event");
+    m_Statistics.foldSeconds += 1e-3 * milliseconds;
+    for (std::size_t i = 0; i < candidates.size(); ++i)
+    {
+      const PartialCandidate & c = candidates[i];
+      if (!c.folds)
+        continue;
+      CandidateFolds folds;
+      for (int side = 0; side < 2; ++side)
+      {
+        const std::uint8_t outcome = m_HostOutcome[2 * i + side];
+        if (!(outcome & cuda::SideFolded))
+          continue;
+        ++folds.foldedSides;
+        folds.repairedSides += (outcome & cuda::SideRepaired) ? 1 : 0;
+        if (!m_Folds.repair)
+          continue;
+        Vec3 *         out = side == 0 ? c.source : c.target;
+        const double * in = m_HostMoved.Data() + 6 * static_cast<std::size_t>(m_HostCandidateMoved[i]) + 3 * side;
+        for (std::size_t k = 0; k < c.element->points.size(); ++k)
+          for (int a = 0; a < 3; ++a)
+            out[k][a] = in[6 * k + a];
+      }
+      *c.folds = folds;
+    }
   }
 
   /** Copies `count` elements from pinned host memory to `device` on the stream. */
@@ -428,7 +566,7 @@ private:
   const TetrahedronEvaluator &  m_Evaluator;
   ThreadPool                    m_Pool;
   std::unique_ptr<cuda::Stream> m_Stream;
-  std::unique_ptr<cuda::Event>  m_KernelStart, m_KernelEnd;
+  std::unique_ptr<cuda::Event>  m_KernelStart, m_KernelEnd, m_FoldStart, m_FoldEnd;
   cuda::EvaluationConstants     m_Constants;
   cuda::DeviceArray<float>      m_Moving, m_Fixed, m_PackedMoving, m_PackedFixed;
   VolumeTextures m_MovingTextures, m_FixedTextures;
@@ -449,6 +587,18 @@ private:
     m_HostElementTetrahedra, m_HostCandidateElement, m_HostCandidateParent, m_HostCandidateMoved;
   cuda::PinnedArray<std::uint64_t> m_HostFirstItem;
   cuda::PinnedArray<double>        m_HostParents, m_HostMoved;
+  std::size_t                      m_MovedCount{ 0 };
+  // Fold checks: the constraint once (SetFoldHandling), then per batch.
+  cuda::FoldRepairConstants        m_Folds;
+  cuda::DeviceArray<double>        m_FoldReferenceVolumes;
+  cuda::DeviceArray<std::uint32_t> m_PointTetrahedronOffsets, m_PointTetrahedra;
+  cuda::DeviceArray<std::int8_t>   m_Pins;
+  const std::uint8_t *             m_FoldCheck{ nullptr };
+  const std::uint64_t *            m_SideSeeds{ nullptr };
+  cuda::DeviceArray<std::uint8_t>  m_FoldCheckDevice, m_Outcome;
+  cuda::DeviceArray<std::uint64_t> m_SideSeedsDevice;
+  cuda::PinnedArray<std::uint8_t>  m_HostFoldCheck, m_HostOutcome;
+  cuda::PinnedArray<std::uint64_t> m_HostSideSeeds;
 };
 } // namespace
 

@@ -1,0 +1,333 @@
+// The fold check and the Gaussian repair of partial candidates on the device,
+// mirroring CheckCandidateFolds / RepairPoints (src/core): the same points in
+// the same order, the same moves (RepairNoise.h), the same sums in the same
+// order, rounded as on the host (no fused multiply-adds: a repaired point's
+// bits seed its tetrahedra's samples); only the 64 trials of a point run side
+// by side, one lane each.
+#include "FoldRepairKernels.h"
+
+#include "DeviceMemory.h"
+#include "TetrahedronDevice.cuh"
+
+#include "morea/RepairNoise.h"
+
+#include <cstdint>
+
+namespace morea::cuda
+{
+namespace
+{
+using repair_noise::Add;
+using repair_noise::Div;
+using repair_noise::Mul;
+using repair_noise::Sub;
+
+constexpr int          RepairThreads = 128;
+constexpr unsigned     FullMask = 0xffffffffu;
+constexpr std::uint32_t NoPoint = 0xffffffffu;
+
+/** One side of one candidate: its parent's points with the element's points
+ *  replaced by the candidate's (owned by this warp, written in place). */
+struct SideView
+{
+  const std::uint32_t * tetrahedra;
+  const double *        parent;        ///< 3 per point
+  double *              moved;         ///< 6 per element point (this side's half)
+  const std::uint32_t * elementPoints;
+  std::uint32_t         count;
+
+  __device__ int
+  Local(std::uint32_t v) const
+  {
+    for (std::uint32_t k = 0; k < count; ++k)
+      if (elementPoints[k] == v)
+        return static_cast<int>(k);
+    return -1;
+  }
+
+  __device__ const double *
+  Point(std::uint32_t v) const
+  {
+    const int k = Local(v);
+    return k < 0 ? parent + 3 * static_cast<std::size_t>(v) : moved + 6 * k;
+  }
+};
+
+/** FoldConstraint::VolumeViolation. */
+__device__ double
+VolumeViolation(const FoldRepairConstants & k, std::uint32_t t, const double * const c[4], bool & folded)
+{
+  double corners[12];
+  for (int j = 0; j < 4; ++j)
+    for (int a = 0; a < 3; ++a)
+      corners[3 * j + a] = c[j][a];
+  double count = 0.0;
+  const double value =
+    device::VolumeViolation(device::SignedVolume(corners), k.referenceVolumes[t], k.volumeFraction, count);
+  folded = count > 0.0;
+  return value;
+}
+
+/** Tetrahedron t's violation with point `trialPoint` (if any) at `trial`. */
+__device__ double
+TetrahedronViolation(const FoldRepairConstants & k, const SideView & s, std::uint32_t t, std::uint32_t trialPoint,
+                     const double * trial, bool & folded)
+{
+  const double * c[4];
+  for (int j = 0; j < 4; ++j)
+  {
+    const std::uint32_t v = s.tetrahedra[4 * static_cast<std::size_t>(t) + j];
+    c[j] = v == trialPoint ? trial : s.Point(v);
+  }
+  return VolumeViolation(k, t, c, folded);
+}
+
+/** Whether any of the `n` tetrahedra folds (lanes share them). */
+__device__ bool
+AnyFolded(const FoldRepairConstants & k, const SideView & s, const std::uint32_t * tets, std::uint32_t n,
+          unsigned lane)
+{
+  bool any = false;
+  for (std::uint32_t i = lane; i < n; i += 32)
+  {
+    bool folded = false;
+    TetrahedronViolation(k, s, tets[i], NoPoint, nullptr, folded);
+    any = any || folded;
+  }
+  return __any_sync(FullMask, any);
+}
+
+/** BoundedViolation: the sum over point p's tetrahedra in ascending order,
+ *  false once it exceeds `bound`. */
+__device__ bool
+PointViolation(const FoldRepairConstants & k, const SideView & s, std::uint32_t p, const double * trial, double bound,
+               double & value, std::uint32_t & folded)
+{
+  value = 0.0;
+  folded = 0;
+  for (std::uint32_t i = k.pointTetrahedronOffsets[p]; i < k.pointTetrahedronOffsets[p + 1]; ++i)
+  {
+    bool f = false;
+    value = Add(value, TetrahedronViolation(k, s, k.pointTetrahedra[i], trial ? p : NoPoint, trial, f));
+    folded += f;
+    if (value > bound)
+      return false;
+  }
+  return true;
+}
+
+/** Mean distance of p to the planes of the faces opposite it. */
+__device__ double
+DistanceToSurroundingPolyhedron(const FoldRepairConstants & k, const SideView & s, std::uint32_t p)
+{
+  const double * x = s.Point(p);
+  double         sum = 0.0;
+  std::uint32_t  n = 0;
+  for (std::uint32_t i = k.pointTetrahedronOffsets[p]; i < k.pointTetrahedronOffsets[p + 1]; ++i)
+  {
+    const std::uint32_t t = k.pointTetrahedra[i];
+    const double *      f[3];
+    int                 m = 0;
+    for (int j = 0; j < 4; ++j)
+    {
+      const std::uint32_t v = s.tetrahedra[4 * static_cast<std::size_t>(t) + j];
+      if (v != p)
+        f[m++] = s.Point(v);
+    }
+    double u[3], w[3], d[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      u[a] = Sub(f[1][a], f[0][a]);
+      w[a] = Sub(f[2][a], f[0][a]);
+      d[a] = Sub(x[a], f[0][a]);
+    }
+    const double normal[3] = { Sub(Mul(u[1], w[2]), Mul(u[2], w[1])), Sub(Mul(u[2], w[0]), Mul(u[0], w[2])),
+                               Sub(Mul(u[0], w[1]), Mul(u[1], w[0])) };
+    const double area2 =
+      sqrt(Add(Add(Mul(normal[0], normal[0]), Mul(normal[1], normal[1])), Mul(normal[2], normal[2])));
+    if (area2 == 0.0)
+      continue;
+    sum = Add(sum, Div(fabs(Add(Add(Mul(normal[0], d[0]), Mul(normal[1], d[1])), Mul(normal[2], d[2]))), area2));
+    ++n;
+  }
+  return n ? Div(sum, static_cast<double>(n)) : 0.0;
+}
+
+/** Trial `trial` of point p (pin `pin`) around `original`, in the domain. */
+__device__ void
+TrialPosition(const FoldRepairConstants & k, std::uint64_t seed, std::uint32_t round, std::uint32_t p,
+              std::uint32_t trial, const double * original, double scale, const std::int8_t * pin, double * out)
+{
+  double move[3];
+  RepairTrialNormals(seed, round, p, trial, move);
+  for (int a = 0; a < 3; ++a)
+  {
+    const double q = Add(original[a], Mul(scale, move[a]));
+    out[a] = pin[a] < 0 ? k.lower[a] : (pin[a] > 0 ? k.upper[a] : fmin(fmax(q, k.lower[a]), k.upper[a]));
+  }
+}
+
+/** RepairPoints over one side; true when it ends fold-free. */
+__device__ bool
+RepairSide(const FoldRepairConstants & k, const SideView & s, const std::uint32_t * dependent, std::uint32_t n,
+           std::uint64_t seed, unsigned lane)
+{
+  for (std::uint32_t round = 0; round < k.maxRounds; ++round)
+  {
+    // The element's points in a folded tetrahedron.
+    unsigned long long flagged = 0;
+    for (std::uint32_t i = lane; i < n; i += 32)
+    {
+      bool folded = false;
+      TetrahedronViolation(k, s, dependent[i], NoPoint, nullptr, folded);
+      if (folded)
+        for (int j = 0; j < 4; ++j)
+        {
+          const int local = s.Local(s.tetrahedra[4 * static_cast<std::size_t>(dependent[i]) + j]);
+          if (local >= 0)
+            flagged |= 1ull << local;
+        }
+    }
+    for (int offset = 16; offset > 0; offset /= 2)
+      flagged |= __shfl_xor_sync(FullMask, flagged, offset);
+
+    bool          movedAny = false;
+    std::uint32_t previous = 0;
+    bool          first = true;
+    while (true)
+    {
+      // The next flagged point in ascending index, as the host visits them.
+      int           next = -1;
+      std::uint32_t p = 0;
+      for (std::uint32_t m = 0; m < s.count; ++m)
+        if ((flagged >> m) & 1ull)
+        {
+          const std::uint32_t v = s.elementPoints[m];
+          if ((first || v > previous) && (next < 0 || v < p))
+          {
+            next = static_cast<int>(m);
+            p = v;
+          }
+        }
+      if (next < 0)
+        break;
+      first = false;
+      previous = p;
+      const std::int8_t * pin = k.pins + 3 * static_cast<std::size_t>(p);
+      if (pin[0] != 0 && pin[1] != 0 && pin[2] != 0)
+        continue; // corners never move
+      double        currentValue = 0.0;
+      std::uint32_t currentFolded = 0;
+      PointViolation(k, s, p, nullptr, INFINITY, currentValue, currentFolded);
+      if (currentFolded == 0)
+        continue; // fixed by an earlier move in this pass
+      const double scale = DistanceToSurroundingPolyhedron(k, s, p);
+      if (!(scale > 0.0))
+        continue;
+      double * position = s.moved + 6 * next;
+      double   original[3] = { position[0], position[1], position[2] };
+
+      // Each lane: the first of its trials with the lowest (value, folded),
+      // if below the current; then the lowest over the lanes, ties to the
+      // lower trial: the trial the host's sequential scan keeps.
+      double        bestValue = currentValue;
+      std::uint32_t bestFolded = currentFolded;
+      std::uint32_t bestTrial = NoPoint;
+      for (std::uint32_t trial = lane; trial < k.samplesPerPoint; trial += 32)
+      {
+        double candidate[3];
+        TrialPosition(k, seed, round, p, trial, original, scale, pin, candidate);
+        double        value = 0.0;
+        std::uint32_t folded = 0;
+        if (PointViolation(k, s, p, candidate, bestValue, value, folded) &&
+            (value < bestValue || (value <= bestValue && folded < bestFolded)))
+        {
+          bestValue = value;
+          bestFolded = folded;
+          bestTrial = trial;
+        }
+      }
+      for (int offset = 16; offset > 0; offset /= 2)
+      {
+        const double        otherValue = __shfl_xor_sync(FullMask, bestValue, offset);
+        const std::uint32_t otherFolded = __shfl_xor_sync(FullMask, bestFolded, offset);
+        const std::uint32_t otherTrial = __shfl_xor_sync(FullMask, bestTrial, offset);
+        const bool          better =
+          otherValue < bestValue ||
+          (otherValue == bestValue && (otherFolded < bestFolded || (otherFolded == bestFolded && otherTrial < bestTrial)));
+        if (better)
+        {
+          bestValue = otherValue;
+          bestFolded = otherFolded;
+          bestTrial = otherTrial;
+        }
+      }
+      if (bestTrial == NoPoint)
+        continue;
+      double chosen[3];
+      TrialPosition(k, seed, round, p, bestTrial, original, scale, pin, chosen);
+      __syncwarp();
+      if (lane == 0)
+        for (int a = 0; a < 3; ++a)
+          position[a] = chosen[a];
+      __syncwarp();
+      if (chosen[0] != original[0] || chosen[1] != original[1] || chosen[2] != original[2])
+        movedAny = true;
+    }
+    if (!AnyFolded(k, s, dependent, n, lane))
+      return true;
+    if (!movedAny)
+      return false;
+  }
+  return false;
+}
+
+__global__ void
+CheckCandidateFolds(CandidateBatch b, FoldRepairConstants k, const std::uint8_t * check,
+                    const std::uint64_t * sideSeeds, double * moved, std::uint8_t * outcome)
+{
+  const std::size_t warp = (static_cast<std::size_t>(blockIdx.x) * blockDim.x + threadIdx.x) / 32;
+  const unsigned    lane = threadIdx.x % 32;
+  if (warp >= 2 * b.candidates)
+    return; // whole warps only: the block size is a multiple of 32
+  const std::size_t c = warp / 2;
+  const int         side = static_cast<int>(warp % 2);
+  if (!check[c])
+    return;
+  const std::uint32_t e = b.candidateElement[c];
+  SideView            s;
+  s.tetrahedra = b.tetrahedra;
+  s.parent = b.parents + static_cast<std::size_t>(b.candidateParent[c]) * 6 * b.points +
+             static_cast<std::size_t>(side) * 3 * b.points;
+  s.moved = moved + 6 * static_cast<std::size_t>(b.candidateMoved[c]) + 3 * side;
+  s.elementPoints = b.elementPoints + b.elementPointOffsets[e];
+  s.count = b.elementPointOffsets[e + 1] - b.elementPointOffsets[e];
+  const std::uint32_t * dependent = b.elementTetrahedra + b.elementTetrahedronOffsets[e];
+  const std::uint32_t   n = b.elementTetrahedronOffsets[e + 1] - b.elementTetrahedronOffsets[e];
+
+  std::uint8_t result = 0;
+  if (AnyFolded(k, s, dependent, n, lane))
+  {
+    result = SideFolded;
+    if (k.repair && RepairSide(k, s, dependent, n, sideSeeds[2 * c + side], lane))
+      result |= SideRepaired;
+  }
+  if (lane == 0)
+    outcome[2 * c + side] = result;
+}
+} // namespace
+
+void
+LaunchCheckCandidateFolds(const CandidateBatch & batch, const FoldRepairConstants & constants,
+                          const std::uint8_t * check, const std::uint64_t * sideSeeds, double * moved,
+                          std::uint8_t * outcome, void * stream)
+{
+  if (batch.candidates == 0)
+    return;
+  const std::size_t threads = 2 * batch.candidates * 32;
+  const unsigned    blocks = static_cast<unsigned>((threads + RepairThreads - 1) / RepairThreads);
+  CheckCandidateFolds<<<blocks, RepairThreads, 0, static_cast<cudaStream_t>(stream)>>>(batch, constants, check,
+                                                                                       sideSeeds, moved, outcome);
+  Check(cudaGetLastError(), "launching the fold check kernel");
+}
+} // namespace morea::cuda
