@@ -4,6 +4,7 @@
 #ifndef morea_ThreadPool_h
 #define morea_ThreadPool_h
 
+#include <atomic>
 #include <condition_variable>
 #include <cstddef>
 #include <exception>
@@ -47,7 +48,8 @@ private:
   std::condition_variable                    m_Done;
   const std::function<void(std::size_t)> *   m_Work{ nullptr };
   std::size_t                                m_Count{ 0 };
-  std::size_t                                m_Next{ 0 };
+  std::atomic<std::size_t>                   m_Next{ 0 };
+  std::size_t                                m_Grain{ 1 };
   std::size_t                                m_Busy{ 0 };
   std::size_t                                m_Generation{ 0 };
   bool                                       m_Stop{ false };

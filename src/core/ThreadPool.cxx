@@ -23,30 +23,42 @@ ThreadPool::~ThreadPool()
     w.join();
 }
 
-// Takes indices one at a time under the lock: the work items (partial
-// evaluations) take microseconds to milliseconds, far more than the lock.
+// Hands out chunks of indices from an atomic counter: many work items
+// (sampling a candidate, unpacking its values) take well under a microsecond,
+// and 16 threads taking them one at a time under a mutex were serialised on
+// it. Chunks stay small (8 per thread) so that uneven items still balance.
 void
 ThreadPool::RunShare()
 {
-  std::unique_lock<std::mutex> lock(m_Mutex);
-  while (m_Next < m_Count)
+  const std::function<void(std::size_t)> * work = nullptr;
+  std::size_t                              count = 0, grain = 1;
   {
-    const std::size_t i = m_Next++;
-    const auto *      work = m_Work;
-    lock.unlock();
+    std::lock_guard<std::mutex> lock(m_Mutex);
+    work = m_Work;
+    count = m_Count;
+    grain = m_Grain;
+  }
+  if (!work)
+    return;
+  for (;;)
+  {
+    const std::size_t begin = m_Next.fetch_add(grain);
+    if (begin >= count)
+      return;
+    const std::size_t end = std::min(count, begin + grain);
     try
     {
-      (*work)(i);
+      for (std::size_t i = begin; i < end; ++i)
+        (*work)(i);
     }
     catch (...)
     {
-      lock.lock();
+      std::lock_guard<std::mutex> lock(m_Mutex);
       if (!m_Error)
         m_Error = std::current_exception();
-      m_Next = m_Count; // stop handing out work
-      continue;
+      m_Next.store(count); // stop handing out work
+      return;
     }
-    lock.lock();
   }
 }
 
@@ -88,7 +100,8 @@ ThreadPool::ParallelFor(std::size_t count, const std::function<void(std::size_t)
     std::lock_guard<std::mutex> lock(m_Mutex);
     m_Work = &work;
     m_Count = count;
-    m_Next = 0;
+    m_Grain = std::max<std::size_t>(1, count / (8 * (m_Workers.size() + 1)));
+    m_Next.store(0);
     m_Error = nullptr;
     ++m_Generation;
   }

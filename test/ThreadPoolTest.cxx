@@ -1,0 +1,60 @@
+// The thread pool: every index runs exactly once whatever the count and the
+// number of threads, an exception reaches the caller and stops the work, and
+// the pool stays usable for the next call.
+#include "morea/ThreadPool.h"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <stdexcept>
+#include <vector>
+
+using morea::ThreadPool;
+
+TEST(ThreadPool, RunsEveryIndexExactlyOnce)
+{
+  for (std::size_t threads : { 1, 2, 5, 16 })
+  {
+    ThreadPool pool(threads);
+    EXPECT_EQ(pool.NumberOfThreads(), threads);
+    for (std::size_t count : { 0, 1, 7, 129, 1000, 100003 })
+    {
+      std::vector<std::atomic<int>> hits(count);
+      pool.ParallelFor(count, [&](std::size_t i) { hits[i].fetch_add(1); });
+      std::size_t wrong = 0;
+      for (const auto & h : hits)
+        wrong += h.load() != 1;
+      EXPECT_EQ(wrong, 0u) << threads << " threads, " << count << " items";
+    }
+  }
+}
+
+TEST(ThreadPool, UnevenItemsAllFinishBeforeTheCallReturns)
+{
+  ThreadPool       pool(4);
+  std::atomic<int> done{ 0 };
+  pool.ParallelFor(64, [&](std::size_t i) {
+    volatile double x = 0.0;
+    for (std::size_t k = 0; k < (i % 8 == 0 ? 200000 : 10); ++k)
+      x = x + 1.0;
+    done.fetch_add(1);
+  });
+  EXPECT_EQ(done.load(), 64);
+}
+
+TEST(ThreadPool, AnExceptionReachesTheCallerAndThePoolStaysUsable)
+{
+  ThreadPool       pool(4);
+  std::atomic<int> ran{ 0 };
+  EXPECT_THROW(pool.ParallelFor(100000,
+                                [&](std::size_t i) {
+                                  ran.fetch_add(1);
+                                  if (i == 10)
+                                    throw std::runtime_error("item 10");
+                                }),
+               std::runtime_error);
+  EXPECT_LT(ran.load(), 100000) << "work stops being handed out after an error";
+  std::atomic<int> after{ 0 };
+  pool.ParallelFor(1000, [&](std::size_t) { after.fetch_add(1); });
+  EXPECT_EQ(after.load(), 1000);
+}
