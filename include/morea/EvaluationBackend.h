@@ -43,8 +43,7 @@ struct PartialCandidate
   TetrahedronValues * values{ nullptr };
   /** Output of the fold check (see FoldHandling); null: no check. */
   CandidateFolds * folds{ nullptr };
-  /** Seeds the repair's moves: side s (0 source, 1 target) repairs with
-   *  HashCombine(seed, s). */
+  /** Seeds the repair's moves (RepairSeed gives each side's). */
   std::uint64_t seed{ 0 };
   /** False: a candidate still folded after its repair gets no values (its
    *  parent is fold-free, so it cannot replace it). */
@@ -118,6 +117,11 @@ protected:
   BackendStatistics m_Statistics;
   FoldHandling      m_FoldHandling;
 };
+
+/** The seed of the repair of side `side` (0 source, 1 target) of a
+ *  candidate seeded with `candidateSeed`; every backend draws the same. */
+std::uint64_t
+RepairSeed(std::uint64_t candidateSeed, int side);
 
 /** The fold check (and repair) of one candidate, as the CPU backend does it:
  *  the reference for other backends. Rewrites the candidate's points where a

@@ -32,6 +32,12 @@ CandidateCorners(const PartialCandidate & c, const Tetrahedron & t, Corners & so
   target = CornersWithReplacedPoints(t, c.parent->target, c.element->points, c.target);
 }
 
+std::uint64_t
+RepairSeed(std::uint64_t candidateSeed, int side)
+{
+  return HashCombine(candidateSeed, static_cast<std::uint64_t>(side));
+}
+
 CandidateFolds
 CheckCandidateFolds(const PartialCandidate & c, const FoldHandling & handling)
 {
@@ -65,7 +71,7 @@ CheckCandidateFolds(const PartialCandidate & c, const FoldHandling & handling)
     for (std::size_t k = 0; k < element.points.size(); ++k)
       scratch[element.points[k]] = moved[k];
     const RepairResult r = RepairPoints(scratch, &element.points, &element.dependentTetrahedra, *handling.base,
-                                        constraint, HashCombine(c.seed, static_cast<std::uint64_t>(side)),
+                                        constraint, RepairSeed(c.seed, side),
                                         handling.options);
     for (std::size_t k = 0; k < element.points.size(); ++k)
       moved[k] = scratch[element.points[k]];

@@ -167,7 +167,6 @@ struct MoRvGomea::Candidate
   std::vector<TetrahedronValues> values;
   std::vector<double>            sample; ///< the drawn variables (before projection), for the ratio test
   std::size_t                    cluster{ 0 };
-  bool                           folded{ false };
   bool                           accepted{ false };
 };
 
@@ -660,8 +659,7 @@ MoRvGomea::ProcessCandidates(std::vector<Candidate> & candidates, GenerationReco
     ++record.candidates;
     record.folded += folds[i].foldedSides;
     record.repaired += folds[i].repairedSides;
-    c.folded = folds[i].Folded();
-    if (c.folded && !batch[i].evaluateFolded)
+    if (folds[i].Folded() && !batch[i].evaluateFolded)
       continue;
     batchIndex.push_back(i);
     record.tetrahedronEvaluations += static_cast<double>(m_Parallel.elements[c.element].dependentTetrahedra.size());

@@ -13,7 +13,6 @@
 
 #include "morea/ComputeDevices.h"
 #include "morea/Error.h"
-#include "morea/Random.h"
 #include "morea/TetrahedronSampling.h"
 #include "morea/ThreadPool.h"
 
@@ -359,8 +358,8 @@ private:
                     std::to_string(cuda::MaxRepairElementPoints) + " points, not " +
                     std::to_string(c.element->points.size()));
       check[i] = 1;
-      seeds[2 * i] = HashCombine(c.seed, 0);
-      seeds[2 * i + 1] = HashCombine(c.seed, 1);
+      seeds[2 * i] = RepairSeed(c.seed, 0);
+      seeds[2 * i + 1] = RepairSeed(c.seed, 1);
       any = true;
     }
     if (!any)
