@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <set>
 #include <vector>
 
@@ -354,4 +355,261 @@ TEST(ElitistArchive, RemoveIf)
   }
   // A removed point may come back.
   EXPECT_TRUE(archive.Insert(Feasible(3.0, 1.0, 0.0), PayloadOf(3), 3));
+}
+
+namespace
+{
+/** What a verdict of kind Rejected claims: `f` is infeasible or non-finite, or
+ *  an entry equals or dominates it. */
+bool
+RejectedByDominance(const ElitistArchive & archive, const Fitness & f)
+{
+  if (!f.feasible || !std::all_of(f.objectives.begin(), f.objectives.end(), [](double x) { return std::isfinite(x); }))
+    return true;
+  return std::any_of(archive.Entries().begin(), archive.Entries().end(), [&](const morea::ArchiveEntry & e) {
+    return e.fitness.objectives == f.objectives || morea::Dominates(e.fitness.objectives, f.objectives);
+  });
+}
+
+/** Probes for verdicts: random candidates (some equal to an entry, some
+ *  non-finite). */
+Fitness
+RandomProbe(morea::RandomGenerator & random, const ElitistArchive & archive)
+{
+  const double u = random.Uniform();
+  if (u < 0.05 && archive.Size() > 0)
+    return archive.Entries()[static_cast<std::size_t>(random.Uniform() * static_cast<double>(archive.Size()))].fitness;
+  Fitness f = RandomCandidate(random, random.Uniform(), 0.0);
+  if (u > 0.99)
+    f.objectives[1] = u > 0.995 ? std::nan("") : std::numeric_limits<double>::infinity();
+  return f;
+}
+
+ElitistArchive
+FilledArchive(std::size_t capacity, std::size_t insertions, std::uint64_t seed)
+{
+  ElitistArchive         archive(capacity);
+  morea::RandomGenerator random(seed);
+  for (std::uint64_t id = 0; id < insertions; ++id)
+    archive.Insert(RandomCandidate(random, static_cast<double>(id) / static_cast<double>(insertions), 0.0),
+                   PayloadOf(id), id);
+  return archive;
+}
+} // namespace
+
+TEST(ElitistArchive, JudgeAgreesWithAFullScan)
+{
+  // Never thinned, and discretised.
+  for (std::size_t capacity : { 100000, 60 })
+  {
+    const ElitistArchive archive = FilledArchive(capacity, 1500, 5 + capacity);
+    ASSERT_EQ(archive.IsDiscretised(), capacity == 60);
+    morea::RandomGenerator random(11);
+    std::size_t            kinds[3] = {};
+    morea::ArchiveVerdict  previous;
+    for (int i = 0; i < 4000; ++i)
+    {
+      const Fitness               f = RandomProbe(random, archive);
+      const morea::ArchiveVerdict verdict = archive.Judge(f);
+      const bool                  accepts = archive.Accepts(f);
+      ++kinds[static_cast<int>(verdict.kind)];
+      EXPECT_EQ(verdict.kind == morea::ArchiveVerdict::Kind::Accepted, accepts) << i;
+      EXPECT_EQ(verdict.kind == morea::ArchiveVerdict::Kind::Rejected, RejectedByDominance(archive, f)) << i;
+      if (verdict.kind == morea::ArchiveVerdict::Kind::Unknown)
+        EXPECT_TRUE(archive.IsDiscretised()) << i;
+      EXPECT_EQ(verdict.revision, archive.ThinningRevision());
+      // A witness is only a hint: any one, or none, gives the same verdict.
+      EXPECT_EQ(archive.Judge(f, previous.witness).kind, verdict.kind) << i;
+      EXPECT_EQ(archive.Judge(f, random.NextU64() % 2000).kind, verdict.kind) << i;
+      // So does Accepts() from a verdict that knows nothing, or only a witness.
+      morea::ArchiveVerdict blank;
+      EXPECT_EQ(archive.Accepts(f, blank), accepts) << i;
+      morea::ArchiveVerdict hinted = previous;
+      hinted.kind = morea::ArchiveVerdict::Kind::Unknown;
+      EXPECT_EQ(archive.Accepts(f, hinted), accepts) << i;
+      previous = verdict;
+    }
+    // All kinds came up (Unknown only with a grid).
+    EXPECT_GT(kinds[static_cast<int>(morea::ArchiveVerdict::Kind::Rejected)], 100u) << capacity;
+    EXPECT_GT(kinds[static_cast<int>(morea::ArchiveVerdict::Kind::Accepted)], 100u) << capacity;
+    EXPECT_EQ(kinds[static_cast<int>(morea::ArchiveVerdict::Kind::Unknown)] > 0, archive.IsDiscretised()) << capacity;
+  }
+}
+
+TEST(ElitistArchive, RejectionsByDominanceOutlastInsertionsWithoutThinning)
+{
+  // Capacity never reached: entries leave only for a newcomer that dominates
+  // them, which then dominates what they dominated.
+  ElitistArchive                     archive = FilledArchive(100000, 300, 3);
+  const std::uint64_t                revision = archive.ThinningRevision();
+  morea::RandomGenerator             random(4);
+  std::vector<Fitness>               probes;
+  std::vector<morea::ArchiveVerdict> verdicts;
+  for (int i = 0; i < 1500; ++i)
+  {
+    probes.push_back(RandomProbe(random, archive));
+    verdicts.push_back(archive.Judge(probes.back()));
+  }
+  // For the rejected probes: the entries that then equalled or dominated them.
+  std::vector<std::vector<std::uint64_t>> coveredBy(probes.size());
+  for (std::size_t i = 0; i < probes.size(); ++i)
+    if (verdicts[i].kind == morea::ArchiveVerdict::Kind::Rejected)
+      for (const auto & e : archive.Entries())
+        if (e.fitness.objectives == probes[i].objectives || morea::Dominates(e.fitness.objectives, probes[i].objectives))
+          coveredBy[i].push_back(e.id);
+
+  std::vector<morea::ArchiveVerdict> live = verdicts; // brought up to date on every call
+  std::size_t                        removed = 0;
+  for (std::uint64_t id = 1000; id < 2500; ++id)
+  {
+    // Candidates that move the front on, so entries keep being dominated away.
+    Fitness f = RandomCandidate(random, 0.3 + 0.7 * static_cast<double>(id - 1000) / 1500.0, 0.0);
+    for (double & x : f.objectives)
+      x *= 1.0 - 0.05 * static_cast<double>(id - 1000) / 1500.0;
+    const std::size_t before = archive.Size();
+    const bool        inserted = archive.Insert(f, PayloadOf(id), id);
+    removed += before + (inserted ? 1 : 0) - archive.Size();
+    ASSERT_EQ(archive.ThinningRevision(), revision);
+    for (int k = 0; k < 25; ++k)
+    {
+      const std::size_t i = static_cast<std::size_t>(random.Uniform() * static_cast<double>(probes.size()));
+      const bool        accepts = archive.Accepts(probes[i]);
+      if (verdicts[i].kind == morea::ArchiveVerdict::Kind::Rejected)
+        ASSERT_FALSE(accepts) << id << " " << i;
+      morea::ArchiveVerdict snapshot = verdicts[i];
+      ASSERT_EQ(archive.Accepts(probes[i], snapshot), accepts) << id << " " << i;
+      ASSERT_EQ(archive.Accepts(probes[i], live[i]), accepts) << id << " " << i;
+    }
+  }
+  ASSERT_FALSE(archive.IsDiscretised());
+  EXPECT_GT(removed, 100u);
+  // Rejections that outlived every entry that made them: the newcomers
+  // dominating those entries carried them.
+  std::size_t outlived = 0;
+  for (std::size_t i = 0; i < probes.size(); ++i)
+    if (!coveredBy[i].empty() && std::none_of(coveredBy[i].begin(), coveredBy[i].end(), [&](std::uint64_t id) {
+          return std::any_of(archive.Entries().begin(), archive.Entries().end(),
+                             [&](const morea::ArchiveEntry & e) { return e.id == id; });
+        }))
+    {
+      ++outlived;
+      EXPECT_FALSE(archive.Accepts(probes[i])) << i;
+      EXPECT_TRUE(RejectedByDominance(archive, probes[i])) << i;
+    }
+  EXPECT_GT(outlived, 10u);
+}
+
+TEST(ElitistArchive, ThinningRevisionCountsThinningRemovalAndRestore)
+{
+  ElitistArchive         archive(20);
+  morea::RandomGenerator random(8);
+  std::size_t            thinnings = 0, quiet = 0;
+  for (std::uint64_t id = 0; id < 1500; ++id)
+  {
+    const Fitness       f = RandomCandidate(random, static_cast<double>(id) / 1500.0, 0.0);
+    const std::uint64_t revision = archive.ThinningRevision();
+    const auto          before = archive.Entries();
+    const bool          accepts = archive.Accepts(f);
+    std::size_t         dominated = 0;
+    for (const auto & e : before)
+      dominated += accepts && morea::Dominates(f.objectives, e.fitness.objectives);
+    archive.Insert(f, PayloadOf(id), id);
+    // Thinned exactly when the newcomer would overfill the archive.
+    const bool overfull = accepts && before.size() - dominated + 1 > archive.Capacity();
+    EXPECT_EQ(archive.ThinningRevision(), revision + (overfull ? 1 : 0)) << id;
+    if (overfull)
+    {
+      ++thinnings;
+      EXPECT_TRUE(archive.IsDiscretised()) << id;
+    }
+    else
+    {
+      // Nothing thinned: the entries are the old ones less the dominated, plus the newcomer.
+      ++quiet;
+      std::vector<ObjectiveVector> expected;
+      for (const auto & e : before)
+        if (!accepts || !morea::Dominates(f.objectives, e.fitness.objectives))
+          expected.push_back(e.fitness.objectives);
+      if (accepts)
+        expected.push_back(f.objectives);
+      ASSERT_EQ(archive.Objectives(), expected) << id;
+    }
+  }
+  EXPECT_GT(thinnings, 10u);
+  EXPECT_GT(quiet, 100u);
+
+  std::uint64_t revision = archive.ThinningRevision();
+  archive.RemoveIf([](const morea::ArchiveEntry & e) { return e.id % 2 == 0; });
+  EXPECT_EQ(archive.ThinningRevision(), ++revision);
+  archive.Restore(archive.Entries(), archive.IsDiscretised(), archive.CellWidths());
+  EXPECT_EQ(archive.ThinningRevision(), ++revision);
+}
+
+TEST(ElitistArchive, VerdictsGiveTheAnswersOfFullScans)
+{
+  // Two archives fed alike, one asked by full scans, the other through
+  // verdicts taken at the start of each batch (as the optimiser does): the
+  // same answers and the same contents throughout, with and without thinning,
+  // steering removals and restores.
+  for (std::size_t capacity : { 100000, 40 })
+  {
+    ElitistArchive         plain(capacity), judged(capacity);
+    morea::RandomGenerator random(21 + capacity);
+    std::uint64_t          id = 0;
+    std::size_t            viaVerdicts = 0;
+    for (int batch = 0; batch < 40; ++batch)
+    {
+      std::vector<Fitness> batchFitness;
+      for (int k = 0; k < 150; ++k)
+        batchFitness.push_back(RandomCandidate(random, static_cast<double>(batch) / 40.0, 0.0));
+      std::vector<morea::ArchiveVerdict> verdicts;
+      std::uint64_t                      witness = 0;
+      for (const Fitness & f : batchFitness)
+      {
+        verdicts.push_back(judged.Judge(f, witness));
+        witness = verdicts.back().witness;
+      }
+      const std::uint64_t revision = judged.ThinningRevision();
+      for (std::size_t b = 0; b < batchFitness.size(); ++b)
+      {
+        // Steering's removals, and restores, in mid-batch: the verdicts before
+        // them go stale.
+        if (b == batchFitness.size() / 2 && batch % 5 == 4)
+        {
+          const double limit = 1.2 + random.Uniform();
+          auto         steer = [limit](const morea::ArchiveEntry & e) { return e.fitness.objectives[2] > limit; };
+          plain.RemoveIf(steer);
+          judged.RemoveIf(steer);
+        }
+        if (b == batchFitness.size() / 2 && batch % 5 == 2)
+          judged.Restore(judged.Entries(), judged.IsDiscretised(), judged.CellWidths());
+        Fitness f = batchFitness[b];
+        if (random.Uniform() < 0.2)
+        {
+          // Its solution changed since: the verdict is on another fitness.
+          f.objectives[0] *= 0.999;
+          verdicts[b].kind = morea::ArchiveVerdict::Kind::Unknown;
+        }
+        viaVerdicts += verdicts[b].kind != morea::ArchiveVerdict::Kind::Unknown && judged.ThinningRevision() == revision;
+        const bool accepts = plain.Accepts(f);
+        ASSERT_EQ(judged.Accepts(f, verdicts[b]), accepts) << capacity << " " << batch << " " << b;
+        // Inserted when accepted, or (like a candidate that dominates its
+        // parent) regardless, for Insert to decide.
+        if (accepts || random.Uniform() < 0.3)
+        {
+          ASSERT_EQ(judged.Insert(f, PayloadOf(id), id, verdicts[b]), plain.Insert(f, PayloadOf(id), id))
+            << capacity << " " << batch << " " << b;
+          ++id;
+        }
+      }
+      ASSERT_EQ(judged.Objectives(), plain.Objectives()) << capacity << " " << batch;
+      ASSERT_EQ(judged.IsDiscretised(), plain.IsDiscretised()) << capacity << " " << batch;
+      ASSERT_EQ(judged.CellWidths(), plain.CellWidths()) << capacity << " " << batch;
+      for (std::size_t i = 0; i < plain.Size(); ++i)
+        ASSERT_EQ(judged.Entries()[i].id, plain.Entries()[i].id) << capacity << " " << batch;
+    }
+    EXPECT_EQ(plain.IsDiscretised(), capacity == 40);
+    // Thinning makes the verdicts of the rest of a batch stale.
+    EXPECT_GT(viaVerdicts, capacity == 40 ? 200u : 3000u) << capacity;
+  }
 }

@@ -14,6 +14,7 @@
 #include <iterator>
 #include <random>
 #include <sstream>
+#include <utility>
 
 using namespace morea;
 using morea_test::OptimiserTestProblem;
@@ -139,6 +140,103 @@ TEST(MoRvGomea, SameSeedSameFrontWhateverTheThreadsOrEvaluationOrder)
   EXPECT_EQ(a, RunToEnd(problem, *three, fourHostThreads));
   const auto d = RunToEnd(problem, *one, problem.Options(22, 6));
   EXPECT_NE(a, d);
+}
+
+TEST(MoRvGomea, SeededRunsGiveTheRecordedResults)
+{
+  // Recorded with the optimiser as it was before its acceptance step judged
+  // candidates against the archive in parallel (ElitistArchive::Judge), which
+  // must not change any result: the accepted counts and the archive's
+  // identifiers (handed out in acceptance order) pin every acceptance
+  // decision, the objective values the arithmetic. Recorded on x86-64 with GCC
+  // (Release); a compiler that rounds differently would need new values.
+  struct Entry
+  {
+    std::size_t     index;
+    std::uint64_t   id;
+    ObjectiveVector objectives;
+  };
+  struct Expected
+  {
+    std::vector<std::size_t> accepted; ///< per generation, the initial record first
+    bool                     discretised;
+    std::size_t              size;
+    std::uint64_t            idSum;
+    double                   hypervolume, bestGuidance;
+    std::vector<Entry>       entries;
+  };
+  OptimiserTestProblem problem;
+  auto                 backend = CreateCpuEvaluationBackend(*problem.evaluator, 2);
+  // A small archive, thinned time and again, with adaptive steering.
+  const GomeaOptions thinned = problem.Options(5, 10);
+  const Expected     thinnedExpected{
+    { 0, 356, 268, 326, 280, 360, 447, 234, 212, 294, 181 },
+    true,
+    13,
+    36866,
+    0.34082973159482194,
+    0.051737519319882977,
+    { { 0, 2298, { { 0.39555693491660437, 0.0010755913862573083, 0.061767462142242373 } } },
+      { 1, 2726, { { 0.18884716252253642, 0.0016029849258790744, 0.091240494355022794 } } },
+      { 2, 2738, { { 0.35576571918057387, 0.0011003742446242316, 0.062780048137067918 } } },
+      { 3, 2864, { { 0.2032461990560013, 0.0015967071986500961, 0.087691919979401373 } } },
+      { 4, 2879, { { 0.20985939439029633, 0.0016117259621372254, 0.085995803331956958 } } },
+      { 5, 2894, { { 0.22493955816209316, 0.0014186627341507378, 0.081073608064217539 } } },
+      { 6, 2895, { { 0.23345602325608841, 0.0013647386097224413, 0.075400772099714533 } } },
+      { 7, 2898, { { 0.28041682025187292, 0.0013136075594678688, 0.073840657979883165 } } },
+      { 8, 2901, { { 0.29095375624986597, 0.0012837988859265711, 0.071323489354617173 } } },
+      { 9, 2903, { { 0.29709806673664113, 0.0011848209248723346, 0.067520194713702672 } } },
+      { 10, 2918, { { 0.16360887249377928, 0.0016363769566233124, 0.091712756553464489 } } },
+      { 11, 2971, { { 0.44757978200186616, 0.00097239824228166031, 0.054221790718979188 } } },
+      { 12, 2981, { { 0.5180151951642924, 0.00094281835799466852, 0.051737519319882977 } } } }
+  };
+  // A large archive that is never thinned, so verdicts stay valid across
+  // acceptances; without steering.
+  GomeaOptions growing = problem.Options(21, 12);
+  growing.archiveCapacity = 2000;
+  growing.steeringEnabled = false;
+  const Expected growingExpected{
+    { 0, 716, 509, 439, 491, 444, 434, 581, 460, 428, 415, 399, 385 },
+    false,
+    621,
+    2665782,
+    0.59371806248828496,
+    0.020916751941671242,
+    { { 0, 0, { { 0, 0.0030555015533522672, 0.17348691352031553 } } },
+      { 1, 12, { { 0.011801526201092649, 0.0027613695363299549, 0.15779547914188502 } } },
+      { 2, 206, { { 0.015604107027562104, 0.0027610943988988293, 0.15778773789298628 } } },
+      { 3, 207, { { 0.015910101305023138, 0.002755705889723722, 0.15537225600407795 } } },
+      { 617, 5689, { { 0.44069502117445652, 0.00048676097210302132, 0.031221368790843598 } } },
+      { 618, 5702, { { 0.44145583602606381, 0.00048666101650976707, 0.031219096336882676 } } },
+      { 619, 5703, { { 0.45746983767086208, 0.00046243177942678783, 0.029173320271669918 } } },
+      { 620, 5704, { { 0.45760558070501461, 0.00046239670434284968, 0.029181164792009186 } } } }
+  };
+  for (const auto & [options, expected] :
+       { std::make_pair(thinned, thinnedExpected), std::make_pair(growing, growingExpected) })
+  {
+    MoRvGomea optimiser(problem.base, problem.topology, problem.parallel, *problem.constraint, *backend, options);
+    optimiser.Initialize(problem.InitialPopulation(options));
+    optimiser.Run();
+    const auto & history = optimiser.History();
+    std::vector<std::size_t> accepted;
+    for (const GenerationRecord & r : history)
+      accepted.push_back(r.accepted);
+    EXPECT_EQ(accepted, expected.accepted) << options.seed;
+    EXPECT_EQ(history.back().hypervolume, expected.hypervolume) << options.seed;
+    EXPECT_EQ(history.back().bestGuidance, expected.bestGuidance) << options.seed;
+    const ElitistArchive & archive = optimiser.Archive();
+    EXPECT_EQ(archive.IsDiscretised(), expected.discretised) << options.seed;
+    ASSERT_EQ(archive.Size(), expected.size) << options.seed;
+    std::uint64_t idSum = 0;
+    for (const ArchiveEntry & e : archive.Entries())
+      idSum += e.id;
+    EXPECT_EQ(idSum, expected.idSum) << options.seed;
+    for (const Entry & e : expected.entries)
+    {
+      EXPECT_EQ(archive.Entries()[e.index].id, e.id) << options.seed << " " << e.index;
+      EXPECT_EQ(archive.Entries()[e.index].fitness.objectives, e.objectives) << options.seed << " " << e.index;
+    }
+  }
 }
 
 TEST(MoRvGomea, ResumedRunEndsWithTheSameFront)

@@ -21,6 +21,25 @@ struct ArchiveEntry
   std::uint64_t id{ 0 };  ///< the optimiser's solution id, for the output files
 };
 
+/** What ElitistArchive::Judge() found about a fitness, for answering Accepts()
+ *  on it later without a full scan. A default verdict knows nothing. */
+struct ArchiveVerdict
+{
+  enum class Kind : std::uint8_t
+  {
+    Unknown,  ///< nothing known (or refused only for sharing a grid cell)
+    Rejected, ///< infeasible, non-finite, or an entry dominates or equals it
+    Accepted  ///< Accepts() was true
+  };
+  Kind          kind{ Kind::Unknown };
+  std::uint64_t revision{ 0 };   ///< the archive's ThinningRevision() then
+  std::uint64_t insertions{ 0 }; ///< entries inserted into the archive before then
+  /** The entry that refused it (its insertion number), tried first when the
+   *  verdict must be taken afresh: a hint, so it may also be left from a
+   *  verdict on a similar fitness (with the kind set to Unknown). */
+  std::uint64_t witness{ 0 };
+};
+
 class ElitistArchive
 {
 public:
@@ -32,16 +51,47 @@ public:
   bool
   Accepts(const Fitness & f) const;
 
+  /** A verdict on `f` against the archive as it is now: Rejected exactly when
+   *  `f` is infeasible or non-finite or an entry equals or dominates it,
+   *  Accepted exactly when Accepts(f), else Unknown. Tries the entry `witness`
+   *  (an earlier verdict's) first, a hint that does not change the verdict.
+   *  Safe to call from several threads at once (while nothing changes the
+   *  archive). */
+  ArchiveVerdict
+  Judge(const Fitness & f, std::uint64_t witness = 0) const;
+
+  /** Accepts(f), answered from a verdict on the same `f` taken earlier (by
+   *  Judge() or by this call), which it brings up to date. While the archive has
+   *  since only gained entries and lost dominated ones (ThinningRevision()
+   *  unchanged), a rejection still holds (a dominated entry leaves only for a
+   *  newcomer that dominates it, and so `f` too) and an acceptance needs a look
+   *  at the newer entries only; otherwise this scans as Accepts(f) does.
+   *  Not for concurrent calls. */
+  bool
+  Accepts(const Fitness & f, ArchiveVerdict & verdict) const;
+
   /** Inserts when Accepts(); removes the entries the new one dominates. When
    *  the size would exceed the capacity, objective space is discretised (cell
    *  widths from the entries' ranges) and entries sharing a cell are thinned,
    *  widening the cells until the size fits. Returns whether it was inserted. */
   bool
   Insert(const Fitness & f, const DualMesh & solution, std::uint64_t id);
+  /** The same, deciding whether it enters by Accepts(f, verdict). */
+  bool
+  Insert(const Fitness & f, const DualMesh & solution, std::uint64_t id, ArchiveVerdict & verdict);
 
   /** Removes the entries for which `remove` returns true (adaptive steering). */
   void
   RemoveIf(const std::function<bool(const ArchiveEntry &)> & remove);
+
+  /** Counts the changes after which a verdict must be taken afresh: thinning
+   *  (with the grid's widths set anew), RemoveIf() and Restore(). Entries
+   *  entering, and leaving for a newcomer that dominates them, do not count. */
+  std::uint64_t
+  ThinningRevision() const
+  {
+    return m_Revision;
+  }
 
   const std::vector<ArchiveEntry> &
   Entries() const
@@ -78,8 +128,40 @@ public:
   Restore(std::vector<ArchiveEntry> entries, bool discretised, const ObjectiveVector & cellWidths);
 
 private:
+  /** What the scans read of an entry, kept apart from the payloads so a scan
+   *  runs through a small array. */
+  struct Key
+  {
+    ObjectiveVector objectives;
+    /** Entries inserted before it: ascending in entry order, so the entries
+     *  newer than a verdict are a suffix. */
+    std::uint64_t serial;
+  };
+  class EntryTest;
+  struct Refuser;
+
+  /** The first entry that `refuses`, trying entries `first` and `second`
+   *  (hints; out of range for none) before all in order. */
+  Refuser
+  FindRefuser(const EntryTest & refuses, std::size_t first, std::size_t second) const;
+  /** Records in `verdict` what a scan found. */
+  void
+  Settle(ArchiveVerdict & verdict, const Refuser & refuser) const;
+  /** Index of the entry with insertion number `serial`, or Size(). */
+  std::size_t
+  IndexOf(std::uint64_t serial) const;
+  /** Inserts `f`, known to be accepted now. */
+  bool
+  InsertAccepted(const Fitness & f, const DualMesh & solution, std::uint64_t id);
+  /** Removes the entries for which keep[i] is false, in order. */
+  void
+  Compact(const std::vector<bool> & keep);
+
   std::size_t               m_Capacity;
   std::vector<ArchiveEntry> m_Entries;
+  std::vector<Key>          m_Keys; ///< per entry, in entry order
+  std::uint64_t             m_Insertions{ 0 };
+  std::uint64_t             m_Revision{ 0 };
   bool                      m_Discretised{ false };
   ObjectiveVector           m_CellWidths{ { 0.0, 0.0, 0.0 } };
   /** Index of the entry that last rejected a candidate; tried first (a

@@ -103,7 +103,81 @@ AllFinite(const ObjectiveVector & v)
 {
   return std::all_of(v.begin(), v.end(), [](double x) { return std::isfinite(x); });
 }
+
+// The scans' inner tests, inlined and without branches (early exits would be
+// mispredicted about half the time); the same comparisons as Dominates() in
+// ParetoFront.cxx, so the same answers, NaNs included.
+
+/** Dominates(a, b). */
+bool
+ParetoDominates(const ObjectiveVector & a, const ObjectiveVector & b)
+{
+  bool worse = false;
+  bool better = false;
+  for (std::size_t j = 0; j < M; ++j)
+  {
+    worse |= a[j] > b[j];
+    better |= a[j] < b[j];
+  }
+  return !worse && better;
+}
+
+/** y == f || Dominates(y, f). */
+bool
+EqualsOrDominates(const ObjectiveVector & y, const ObjectiveVector & f)
+{
+  bool worse = false;
+  bool better = false;
+  bool equal = true;
+  for (std::size_t j = 0; j < M; ++j)
+  {
+    worse |= y[j] > f[j];
+    better |= y[j] < f[j];
+    equal &= y[j] == f[j];
+  }
+  return !worse && (better || equal);
+}
+
+enum class Refusal
+{
+  None,
+  Dominance, ///< the entry equals or dominates the candidate
+  Cell       ///< (discretised) they share a cell, and the candidate does not dominate it
+};
 } // namespace
+
+/** Why, if at all, an entry keeps candidate `f` out of the archive. */
+class ElitistArchive::EntryTest
+{
+public:
+  EntryTest(const ObjectiveVector & f, bool discretised, const ObjectiveVector & widths)
+    : m_F(f)
+    , m_Discretised(discretised)
+    , m_Widths(widths)
+    , m_Cell(discretised ? CellOf(f, widths) : Cell{})
+  {}
+  Refusal
+  operator()(const ObjectiveVector & y) const
+  {
+    if (EqualsOrDominates(y, m_F))
+      return Refusal::Dominance;
+    if (m_Discretised && CellOf(y, m_Widths) == m_Cell && !ParetoDominates(m_F, y))
+      return Refusal::Cell;
+    return Refusal::None;
+  }
+
+private:
+  ObjectiveVector m_F;
+  bool            m_Discretised;
+  ObjectiveVector m_Widths;
+  Cell            m_Cell;
+};
+
+struct ElitistArchive::Refuser
+{
+  std::size_t index; ///< Size() if none
+  Refusal     refusal;
+};
 
 ElitistArchive::ElitistArchive(std::size_t capacity)
   : m_Capacity(capacity)
@@ -118,34 +192,140 @@ ElitistArchive::Accepts(const Fitness & f) const
   // Non-finite objectives would make dominance meaningless, so they never enter.
   if (!f.feasible || !AllFinite(f.objectives))
     return false;
-  const Cell cell = m_Discretised ? CellOf(f.objectives, m_CellWidths) : Cell{};
-  auto       rejects = [&](const ArchiveEntry & e) {
-    const ObjectiveVector & y = e.fitness.objectives;
-    if (y == f.objectives || Dominates(y, f.objectives))
-      return true;
-    return m_Discretised && CellOf(y, m_CellWidths) == cell && !Dominates(f.objectives, y);
-  };
   // The optimiser asks about many near-copies of one solution in a row, and
   // the entry that turned one away usually turns away the next: trying it
   // first saves the scan without changing the answer.
-  if (m_RejectorHint < m_Entries.size() && rejects(m_Entries[m_RejectorHint]))
-    return false;
-  for (std::size_t i = 0; i < m_Entries.size(); ++i)
-    if (rejects(m_Entries[i]))
+  const Refuser refuser =
+    FindRefuser(EntryTest(f.objectives, m_Discretised, m_CellWidths), m_RejectorHint, m_Entries.size());
+  if (refuser.refusal == Refusal::None)
+    return true;
+  m_RejectorHint = refuser.index;
+  return false;
+}
+
+ArchiveVerdict
+ElitistArchive::Judge(const Fitness & f, std::uint64_t witness) const
+{
+  ArchiveVerdict verdict{ ArchiveVerdict::Kind::Rejected, m_Revision, m_Insertions, witness };
+  if (!f.feasible || !AllFinite(f.objectives))
+    return verdict;
+  // Dominance first: the refusal that lasts, and cheaper to test than the grid.
+  const std::size_t hint = IndexOf(witness);
+  if (hint < m_Keys.size() && EqualsOrDominates(m_Keys[hint].objectives, f.objectives))
+    return verdict;
+  for (std::size_t i = 0; i < m_Keys.size(); ++i)
+    if (EqualsOrDominates(m_Keys[i].objectives, f.objectives))
     {
-      m_RejectorHint = i;
-      return false;
+      verdict.witness = m_Keys[i].serial;
+      return verdict;
     }
-  return true;
+  // Then the grid, which now can only refuse for a shared cell.
+  Settle(verdict, m_Discretised ? FindRefuser(EntryTest(f.objectives, true, m_CellWidths), hint, m_Keys.size())
+                                : Refuser{ m_Keys.size(), Refusal::None });
+  return verdict;
+}
+
+bool
+ElitistArchive::Accepts(const Fitness & f, ArchiveVerdict & verdict) const
+{
+  using Kind = ArchiveVerdict::Kind;
+  if (verdict.revision == m_Revision && verdict.kind == Kind::Rejected)
+    return false;
+  if (verdict.revision == m_Revision && verdict.kind == Kind::Accepted)
+  {
+    // No entry of the verdict's time refused `f`, and with the grid unchanged
+    // none of those still here does now: only the newer ones can.
+    const EntryTest refuses(f.objectives, m_Discretised, m_CellWidths);
+    const auto      newer = std::lower_bound(m_Keys.begin(), m_Keys.end(), verdict.insertions,
+                                        [](const Key & k, std::uint64_t serial) { return k.serial < serial; });
+    Refuser         refuser{ m_Keys.size(), Refusal::None };
+    for (auto i = static_cast<std::size_t>(newer - m_Keys.begin()); i < m_Keys.size(); ++i)
+      if (const Refusal refusal = refuses(m_Keys[i].objectives); refusal != Refusal::None)
+      {
+        refuser = Refuser{ i, refusal };
+        break;
+      }
+    verdict.insertions = m_Insertions;
+    Settle(verdict, refuser);
+    return verdict.kind == Kind::Accepted;
+  }
+
+  // Afresh, as Accepts(f), trying the witness first.
+  verdict.revision = m_Revision;
+  verdict.insertions = m_Insertions;
+  if (!f.feasible || !AllFinite(f.objectives))
+  {
+    verdict.kind = Kind::Rejected;
+    return false;
+  }
+  const Refuser refuser =
+    FindRefuser(EntryTest(f.objectives, m_Discretised, m_CellWidths), IndexOf(verdict.witness), m_RejectorHint);
+  if (refuser.refusal != Refusal::None)
+    m_RejectorHint = refuser.index;
+  Settle(verdict, refuser);
+  return verdict.kind == Kind::Accepted;
+}
+
+ElitistArchive::Refuser
+ElitistArchive::FindRefuser(const EntryTest & refuses, std::size_t first, std::size_t second) const
+{
+  for (std::size_t hint : { first, second })
+    if (hint < m_Keys.size())
+      if (const Refusal refusal = refuses(m_Keys[hint].objectives); refusal != Refusal::None)
+        return Refuser{ hint, refusal };
+  for (std::size_t i = 0; i < m_Keys.size(); ++i)
+    if (const Refusal refusal = refuses(m_Keys[i].objectives); refusal != Refusal::None)
+      return Refuser{ i, refusal };
+  return Refuser{ m_Keys.size(), Refusal::None };
+}
+
+void
+ElitistArchive::Settle(ArchiveVerdict & verdict, const Refuser & refuser) const
+{
+  switch (refuser.refusal)
+  {
+    case Refusal::None:
+      verdict.kind = ArchiveVerdict::Kind::Accepted;
+      return;
+    case Refusal::Dominance:
+      verdict.kind = ArchiveVerdict::Kind::Rejected;
+      break;
+    case Refusal::Cell: // may not last: the entry can leave for a newcomer outside the cell
+      verdict.kind = ArchiveVerdict::Kind::Unknown;
+      break;
+  }
+  verdict.witness = m_Keys[refuser.index].serial;
+}
+
+std::size_t
+ElitistArchive::IndexOf(std::uint64_t serial) const
+{
+  const auto it = std::lower_bound(m_Keys.begin(), m_Keys.end(), serial,
+                                   [](const Key & k, std::uint64_t wanted) { return k.serial < wanted; });
+  return it != m_Keys.end() && it->serial == serial ? static_cast<std::size_t>(it - m_Keys.begin()) : m_Keys.size();
 }
 
 bool
 ElitistArchive::Insert(const Fitness & f, const DualMesh & solution, std::uint64_t id)
 {
-  if (!Accepts(f))
-    return false;
-  RemoveIf([&](const ArchiveEntry & e) { return Dominates(f.objectives, e.fitness.objectives); });
+  return Accepts(f) && InsertAccepted(f, solution, id);
+}
+
+bool
+ElitistArchive::Insert(const Fitness & f, const DualMesh & solution, std::uint64_t id, ArchiveVerdict & verdict)
+{
+  return Accepts(f, verdict) && InsertAccepted(f, solution, id);
+}
+
+bool
+ElitistArchive::InsertAccepted(const Fitness & f, const DualMesh & solution, std::uint64_t id)
+{
+  std::vector<bool> keep(m_Keys.size());
+  for (std::size_t i = 0; i < m_Keys.size(); ++i)
+    keep[i] = !ParetoDominates(f.objectives, m_Keys[i].objectives);
+  Compact(keep);
   m_Entries.push_back(ArchiveEntry{ f, solution, id });
+  m_Keys.push_back(Key{ f.objectives, m_Insertions++ });
   if (m_Entries.size() <= m_Capacity)
     return true;
 
@@ -154,33 +334,48 @@ ElitistArchive::Insert(const Fitness & f, const DualMesh & solution, std::uint64
   // Each try thins the full set rather than the previous try's survivors: the
   // grids of different widths are not nested, and thinning the full set keeps
   // every dropped entry in a cell of a kept one, so Accepts() rejects it later.
+  ++m_Revision;
   m_Discretised = true;
   m_CellWidths = InitialCellWidths(m_Entries, m_Capacity);
-  std::vector<bool> keep = OnePerCell(m_Entries, m_CellWidths);
+  keep = OnePerCell(m_Entries, m_CellWidths);
   while (static_cast<std::size_t>(std::count(keep.begin(), keep.end(), true)) > m_Capacity)
   {
     for (double & w : m_CellWidths)
       w *= 1.1;
     keep = OnePerCell(m_Entries, m_CellWidths);
   }
-  const bool  newcomerKept = keep.back();
-  std::size_t kept = 0;
-  for (std::size_t i = 0; i < m_Entries.size(); ++i)
-    if (keep[i])
-    {
-      if (kept != i) // a self-move would empty the meshes
-        m_Entries[kept] = std::move(m_Entries[i]);
-      ++kept;
-    }
-  m_Entries.resize(kept);
+  const bool newcomerKept = keep.back();
+  Compact(keep);
   // A newcomer thinned out at once did not improve the archive: report false.
   return newcomerKept;
 }
 
 void
+ElitistArchive::Compact(const std::vector<bool> & keep)
+{
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < m_Entries.size(); ++i)
+    if (keep[i])
+    {
+      if (kept != i) // a self-move would empty the meshes
+      {
+        m_Entries[kept] = std::move(m_Entries[i]);
+        m_Keys[kept] = m_Keys[i];
+      }
+      ++kept;
+    }
+  m_Entries.resize(kept);
+  m_Keys.resize(kept);
+}
+
+void
 ElitistArchive::RemoveIf(const std::function<bool(const ArchiveEntry &)> & remove)
 {
-  m_Entries.erase(std::remove_if(m_Entries.begin(), m_Entries.end(), remove), m_Entries.end());
+  std::vector<bool> keep(m_Entries.size());
+  for (std::size_t i = 0; i < m_Entries.size(); ++i)
+    keep[i] = !remove(m_Entries[i]);
+  Compact(keep);
+  ++m_Revision; // the removed entries may have been what kept a verdict's fitness out
 }
 
 std::vector<ObjectiveVector>
@@ -200,7 +395,11 @@ ElitistArchive::Restore(std::vector<ArchiveEntry> entries, bool discretised, con
     throw Error("elitist archive: cannot restore " + std::to_string(entries.size()) + " entries into a capacity of " +
                 std::to_string(m_Capacity));
   m_Entries = std::move(entries);
+  m_Keys.clear();
+  for (const ArchiveEntry & e : m_Entries)
+    m_Keys.push_back(Key{ e.fitness.objectives, m_Insertions++ });
   m_Discretised = discretised;
   m_CellWidths = cellWidths;
+  ++m_Revision;
 }
 } // namespace morea

@@ -261,9 +261,7 @@ MoRvGomea::EvaluateFully(const DualMesh & solution)
 bool
 MoRvGomea::InsertIntoArchive(std::size_t s, const Fitness & fitness)
 {
-  if (!m_Archive->Accepts(fitness))
-    return false;
-  return m_Archive->Insert(fitness, m_Population[s], m_Ids[s]);
+  return m_Archive->Insert(fitness, m_Population[s], m_Ids[s]); // it asks Accepts() itself
 }
 
 void
@@ -669,21 +667,37 @@ MoRvGomea::ProcessCandidates(std::vector<Candidate> & candidates, GenerationReco
   //    tetrahedra, so each one's change of the totals does not depend on the
   //    others and is summed in parallel first (reading the stored values is
   //    bound by memory latency); each then sees the totals left by the ones
-  //    before it.
+  //    before it. The archive's scans are done in parallel too, as verdicts
+  //    on each candidate as if it came first: the ordered pass brings them up
+  //    to date cheaply (ElitistArchive::Accepts(f, verdict)), except for a
+  //    solution changed by an earlier candidate (the verdict is on other totals).
+  //    Runs of neighbouring candidates (mostly of one solution) are judged in
+  //    turn, each trying first the entry that refused the one before.
+  constexpr std::size_t          Run = 16;
   std::vector<TetrahedronValues> changes(batchIndex.size());
-  m_Pool->ParallelFor(batchIndex.size(), [&](std::size_t b) {
-    const Candidate &  c = candidates[batchIndex[b]];
-    const FosElement & element = m_Parallel.elements[c.element];
-    const auto &       stored = m_TetValues[c.solution];
-    ObjectiveTotals    change;
-    for (std::size_t k = 0; k < element.dependentTetrahedra.size(); ++k)
+  std::vector<ArchiveVerdict>    verdicts(batchIndex.size());
+  m_Pool->ParallelFor((batchIndex.size() + Run - 1) / Run, [&](std::size_t r) {
+    std::uint64_t witness{ 0 };
+    for (std::size_t b = r * Run; b < std::min(batchIndex.size(), (r + 1) * Run); ++b)
     {
-      change.Add(stored[element.dependentTetrahedra[k]], -1.0);
-      change.Add(c.values[k]);
+      const Candidate &  c = candidates[batchIndex[b]];
+      const FosElement & element = m_Parallel.elements[c.element];
+      const auto &       stored = m_TetValues[c.solution];
+      ObjectiveTotals    change;
+      for (std::size_t k = 0; k < element.dependentTetrahedra.size(); ++k)
+      {
+        change.Add(stored[element.dependentTetrahedra[k]], -1.0);
+        change.Add(c.values[k]);
+      }
+      changes[b] = change.sum;
+      ObjectiveTotals totals = m_Totals[c.solution];
+      totals.Add(changes[b]);
+      verdicts[b] = m_Archive->Judge(Steered(totals.ToFitness(m_Topology.NumberOfTetrahedra())), witness);
+      witness = verdicts[b].witness;
     }
-    changes[b] = change.sum;
   });
-  std::size_t accepted = 0;
+  std::vector<bool> changed(m_Population.size(), false);
+  std::size_t       accepted = 0;
   for (std::size_t b = 0; b < batchIndex.size(); ++b)
   {
     Candidate &        c = candidates[batchIndex[b]];
@@ -691,9 +705,12 @@ MoRvGomea::ProcessCandidates(std::vector<Candidate> & candidates, GenerationReco
     const std::size_t  s = c.solution;
     ObjectiveTotals    totals = m_Totals[s];
     totals.Add(changes[b]);
-    const Fitness now = CurrentFitness(s);
-    const Fitness next = Steered(totals.ToFitness(m_Topology.NumberOfTetrahedra()));
-    bool          accept = false;
+    const Fitness    now = CurrentFitness(s);
+    const Fitness    next = Steered(totals.ToFitness(m_Topology.NumberOfTetrahedra()));
+    ArchiveVerdict & verdict = verdicts[b];
+    bool             accept = false;
+    if (changed[s]) // the verdict is on other totals: its witness is only a hint now
+      verdict.kind = ArchiveVerdict::Kind::Unknown;
     if (c.forced)
       accept = ConstraintDominates(next, now);
     else if (c.singleObjective >= 0)
@@ -707,7 +724,7 @@ MoRvGomea::ProcessCandidates(std::vector<Candidate> & candidates, GenerationReco
         accept = next.objectives[m] < now.objectives[m];
     }
     else
-      accept = ConstraintDominates(next, now) || m_Archive->Accepts(next);
+      accept = ConstraintDominates(next, now) || m_Archive->Accepts(next, verdict);
     if (!accept)
       continue;
     DualMesh & solution = m_Population[s];
@@ -719,8 +736,9 @@ MoRvGomea::ProcessCandidates(std::vector<Candidate> & candidates, GenerationReco
     for (std::size_t k = 0; k < element.dependentTetrahedra.size(); ++k)
       m_TetValues[s][element.dependentTetrahedra[k]] = c.values[k];
     m_Totals[s] = totals;
+    changed[s] = true;
     m_Ids[s] = m_NextId++;
-    InsertIntoArchive(s, next);
+    m_Archive->Insert(next, solution, m_Ids[s], verdict);
     c.accepted = true;
     ++accepted;
   }
