@@ -35,9 +35,19 @@ struct Fitness
   double          constraint{ 0.0 }; ///< > = 0; compared only between infeasible solutions
 };
 
-/** Pareto dominance of objective vectors: no worse in all, better in one. */
-bool
-Dominates(const ObjectiveVector & a, const ObjectiveVector & b);
+/** Pareto dominance of objective vectors: no worse in all, better in one.
+ *  Inline and branch-free: the archive's scans call it millions of times. */
+inline bool
+Dominates(const ObjectiveVector & a, const ObjectiveVector & b)
+{
+  bool worse = false, better = false;
+  for (std::size_t j = 0; j < a.size(); ++j)
+  {
+    worse |= a[j] > b[j];
+    better |= a[j] < b[j];
+  }
+  return !worse && better;
+}
 
 /** Constraint domination (Deb): feasible beats infeasible; of two infeasible
  *  solutions the smaller constraint value wins; two feasible ones compare by

@@ -108,20 +108,6 @@ AllFinite(const ObjectiveVector & v)
 // mispredicted about half the time); the same comparisons as Dominates() in
 // ParetoFront.cxx, so the same answers, NaNs included.
 
-/** Dominates(a, b). */
-bool
-ParetoDominates(const ObjectiveVector & a, const ObjectiveVector & b)
-{
-  bool worse = false;
-  bool better = false;
-  for (std::size_t j = 0; j < M; ++j)
-  {
-    worse |= a[j] > b[j];
-    better |= a[j] < b[j];
-  }
-  return !worse && better;
-}
-
 /** y == f || Dominates(y, f). */
 bool
 EqualsOrDominates(const ObjectiveVector & y, const ObjectiveVector & f)
@@ -161,7 +147,7 @@ public:
   {
     if (EqualsOrDominates(y, m_F))
       return Refusal::Dominance;
-    if (m_Discretised && CellOf(y, m_Widths) == m_Cell && !ParetoDominates(m_F, y))
+    if (m_Discretised && CellOf(y, m_Widths) == m_Cell && !Dominates(m_F, y))
       return Refusal::Cell;
     return Refusal::None;
   }
@@ -322,7 +308,7 @@ ElitistArchive::InsertAccepted(const Fitness & f, const DualMesh & solution, std
 {
   std::vector<bool> keep(m_Keys.size());
   for (std::size_t i = 0; i < m_Keys.size(); ++i)
-    keep[i] = !ParetoDominates(f.objectives, m_Keys[i].objectives);
+    keep[i] = !Dominates(f.objectives, m_Keys[i].objectives);
   Compact(keep);
   m_Entries.push_back(ArchiveEntry{ f, solution, id });
   m_Keys.push_back(Key{ f.objectives, m_Insertions++ });

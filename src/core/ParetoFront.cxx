@@ -148,19 +148,6 @@ private:
 } // namespace
 
 bool
-Dominates(const ObjectiveVector & a, const ObjectiveVector & b)
-{
-  bool better = false;
-  for (std::size_t j = 0; j < M; ++j)
-  {
-    if (a[j] > b[j])
-      return false;
-    better = better || a[j] < b[j];
-  }
-  return better;
-}
-
-bool
 ConstraintDominates(const Fitness & a, const Fitness & b)
 {
   if (a.feasible != b.feasible)
