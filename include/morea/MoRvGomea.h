@@ -87,6 +87,8 @@ struct GenerationRecord
     double evaluation{ 0.0 };
     double acceptance{ 0.0 };
     double forcedImprovements{ 0.0 }; ///< all of it, its own phases included
+    double modelling{ 0.0 };   ///< steering, selection, clustering and estimation
+    double bookkeeping{ 0.0 }; ///< multipliers, periodic full evaluation and the summary
   } phaseSeconds;
 };
 
@@ -174,10 +176,10 @@ private:
   struct Candidate;
 
   /** Draws each candidate's variables (its solution, element, cluster and
-   *  seed are set) from `cluster`'s distribution for its element, in
+   *  seed are set) from its cluster's distribution for its element, in
    *  parallel: each candidate has its own random stream. */
   void
-  SampleCandidates(std::vector<Candidate> & candidates, const ClusterModel & cluster);
+  SampleCandidates(std::vector<Candidate> & candidates, const std::vector<ClusterModel> & clusters);
 
   Fitness
   Steered(const Fitness & raw) const;

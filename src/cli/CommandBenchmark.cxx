@@ -88,12 +88,15 @@ TimeBackend(const std::string & name, const itk::morea::MeshModel & model, const
                                   { "fold_checks_and_repair", r.phaseSeconds.foldChecks },
                                   { "evaluation", r.phaseSeconds.evaluation },
                                   { "acceptance", r.phaseSeconds.acceptance },
-                                  { "forced_improvements", r.phaseSeconds.forcedImprovements } } } });
+                                  { "forced_improvements", r.phaseSeconds.forcedImprovements },
+                                  { "modelling", r.phaseSeconds.modelling },
+                                  { "bookkeeping", r.phaseSeconds.bookkeeping } } } });
     std::cout << "    generation " << r.generation << ": " << std::fixed << std::setprecision(3) << seconds
               << " s (backend " << after.seconds - before.seconds << " s, kernels "
               << after.kernelSeconds - before.kernelSeconds << " s; sampling " << r.phaseSeconds.sampling
               << ", folds " << r.phaseSeconds.foldChecks << ", acceptance " << r.phaseSeconds.acceptance
-              << ", forced " << r.phaseSeconds.forcedImprovements << "), best guidance " << std::defaultfloat
+              << ", forced " << r.phaseSeconds.forcedImprovements << ", modelling " << r.phaseSeconds.modelling
+              << ", bookkeeping " << r.phaseSeconds.bookkeeping << "), best guidance " << std::defaultfloat
               << r.bestGuidance << "\n"
               << std::flush;
   }

@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <sstream>
@@ -55,7 +56,7 @@ ProgressPrinter()
 {
   const bool terminal = isatty(fileno(stdout)) != 0;
   return [terminal](const ::morea::GenerationRecord & r, std::size_t total) {
-    char line[200];
+    char line[320];
     std::snprintf(line, sizeof line, "generation %zu/%zu  front %zu  best guidance %.4g  hypervolume %.4f  %.2f s",
                   r.generation, total, r.archiveSize, r.bestGuidance, r.hypervolume, r.seconds);
     if (terminal)
@@ -68,7 +69,14 @@ ProgressPrinter()
         std::cout << "\n";
     }
     else if (r.generation % 10 == 0 || r.generation == total)
+    {
+      // Logs also say where the generation's time went.
+      const auto & p = r.phaseSeconds;
+      std::snprintf(line + std::strlen(line), sizeof line - std::strlen(line),
+                    " (evaluation %.2f, folds %.2f, acceptance %.2f, sampling %.2f, modelling %.2f, other %.2f)",
+                    p.evaluation, p.foldChecks, p.acceptance, p.sampling, p.modelling, p.bookkeeping);
       std::cout << line << "\n" << std::flush;
+    }
   };
 }
 
@@ -113,11 +121,15 @@ WriteRegistrationOutputs(const itk::morea::PreprocessResult & preprocessed,
   std::ostringstream log;
   log.precision(10);
   log << "generation,hypervolume,best_guidance,archive_size,feasible,candidates,folded,accepted,repaired,forced_improvements,"
-         "mean_multiplier,tetrahedron_evaluations,seconds\n";
+         "mean_multiplier,tetrahedron_evaluations,seconds,seconds_sampling,seconds_fold_checks,seconds_evaluation,"
+         "seconds_acceptance,seconds_forced_improvements,seconds_modelling,seconds_bookkeeping\n";
   for (const auto & r : result.history)
     log << r.generation << "," << r.hypervolume << "," << r.bestGuidance << "," << r.archiveSize << "," << r.feasible
         << "," << r.candidates << "," << r.folded << "," << r.accepted << "," << r.repaired << "," << r.forcedImprovements << "," << r.meanMultiplier << ","
-        << r.tetrahedronEvaluations << "," << r.seconds << "\n";
+        << r.tetrahedronEvaluations << "," << r.seconds << "," << r.phaseSeconds.sampling << ","
+        << r.phaseSeconds.foldChecks << "," << r.phaseSeconds.evaluation << "," << r.phaseSeconds.acceptance << ","
+        << r.phaseSeconds.forcedImprovements << "," << r.phaseSeconds.modelling << "," << r.phaseSeconds.bookkeeping
+        << "\n";
   WriteTextFile(log.str(), out + "generations.csv");
 
   // The chosen solutions.

@@ -540,50 +540,57 @@ MoRvGomea::BuildClusters(const std::vector<std::size_t> & selection, const std::
 void
 MoRvGomea::EstimateDistributions(std::vector<ClusterModel> & clusters) const
 {
-  for (auto & cluster : clusters)
+  // Every (cluster, element) pair is independent: estimate them in parallel.
+  std::vector<std::pair<std::size_t, std::size_t>> work;
+  for (std::size_t c = 0; c < clusters.size(); ++c)
   {
+    ClusterModel & cluster = clusters[c];
     if (cluster.members.empty() || cluster.population.empty())
       continue;
     cluster.means.resize(m_Parallel.elements.size());
     cluster.cholesky.resize(m_Parallel.elements.size());
-    const double count = static_cast<double>(cluster.members.size());
     for (std::size_t e = 0; e < m_Parallel.elements.size(); ++e)
-    {
-      const FosElement &  element = m_Parallel.elements[e];
-      const std::size_t   n = 6 * element.points.size();
-      std::vector<double> x(n), mean(n, 0.0), covariance(n * n, 0.0);
-      std::vector<double> all(n * cluster.members.size());
-      for (std::size_t j = 0; j < cluster.members.size(); ++j)
-      {
-        Gather(m_Population[cluster.members[j]], element, all.data() + j * n);
-        for (std::size_t i = 0; i < n; ++i)
-          mean[i] += all[j * n + i] / count;
-      }
-      for (std::size_t j = 0; j < cluster.members.size(); ++j)
-      {
-        const double * v = all.data() + j * n;
-        for (std::size_t a = 0; a < n; ++a)
-          for (std::size_t b = 0; b <= a; ++b)
-            covariance[a * n + b] += (v[a] - mean[a]) * (v[b] - mean[b]) / count;
-      }
-      // Few members for many variables give a singular estimate that only
-      // samples the members' span: shrink the off-diagonal part towards 0 by
-      // the ratio of variables to members (the full estimate for large clusters).
-      const double shrink = std::min(1.0, static_cast<double>(n) / count);
-      for (std::size_t a = 0; a < n; ++a)
-        for (std::size_t b = 0; b < a; ++b)
-          covariance[b * n + a] = covariance[a * n + b] *= (1.0 - shrink);
-      cluster.means[e] = std::move(mean);
-      cluster.cholesky[e] = RegularisedCholesky(std::move(covariance), n);
-    }
+      work.emplace_back(c, e);
   }
+  m_Pool->ParallelFor(work.size(), [&](std::size_t w) {
+    ClusterModel &      cluster = clusters[work[w].first];
+    const std::size_t   e = work[w].second;
+    const double        count = static_cast<double>(cluster.members.size());
+    const FosElement &  element = m_Parallel.elements[e];
+    const std::size_t   n = 6 * element.points.size();
+    std::vector<double> mean(n, 0.0), covariance(n * n, 0.0);
+    std::vector<double> all(n * cluster.members.size());
+    for (std::size_t j = 0; j < cluster.members.size(); ++j)
+    {
+      Gather(m_Population[cluster.members[j]], element, all.data() + j * n);
+      for (std::size_t i = 0; i < n; ++i)
+        mean[i] += all[j * n + i] / count;
+    }
+    for (std::size_t j = 0; j < cluster.members.size(); ++j)
+    {
+      const double * v = all.data() + j * n;
+      for (std::size_t a = 0; a < n; ++a)
+        for (std::size_t b = 0; b <= a; ++b)
+          covariance[a * n + b] += (v[a] - mean[a]) * (v[b] - mean[b]) / count;
+    }
+    // Few members for many variables give a singular estimate that only
+    // samples the members' span: shrink the off-diagonal part towards 0 by
+    // the ratio of variables to members (the full estimate for large clusters).
+    const double shrink = std::min(1.0, static_cast<double>(n) / count);
+    for (std::size_t a = 0; a < n; ++a)
+      for (std::size_t b = 0; b < a; ++b)
+        covariance[b * n + a] = covariance[a * n + b] *= (1.0 - shrink);
+    cluster.means[e] = std::move(mean);
+    cluster.cholesky[e] = RegularisedCholesky(std::move(covariance), n);
+  });
 }
 
 void
-MoRvGomea::SampleCandidates(std::vector<Candidate> & candidates, const ClusterModel & cluster)
+MoRvGomea::SampleCandidates(std::vector<Candidate> & candidates, const std::vector<ClusterModel> & clusters)
 {
   m_Pool->ParallelFor(candidates.size(), [&](std::size_t i) {
     Candidate &                 cand = candidates[i];
+    const ClusterModel &        cluster = clusters[cand.cluster];
     const FosElement &          element = m_Parallel.elements[cand.element];
     const std::size_t           dim = 6 * element.points.size();
     const std::vector<double> & mean = cluster.means[cand.element];
@@ -821,6 +828,7 @@ MoRvGomea::RunGeneration()
   const std::vector<std::size_t> selection = Select(fitness, random);
   std::vector<ClusterModel>      clusters = BuildClusters(selection, fitness, random);
   EstimateDistributions(clusters);
+  record.phaseSeconds.modelling = SecondsSince(start);
 
   std::vector<std::size_t> groupOrder(m_Parallel.groups.size());
   std::iota(groupOrder.begin(), groupOrder.end(), std::size_t{ 0 });
@@ -836,50 +844,67 @@ MoRvGomea::RunGeneration()
   const double n = static_cast<double>(m_Population.size());
   const double amsFraction = 0.5 * m_Options.selectionFraction * n / std::max(1.0, n - 1.0);
 
+  // Each solution belongs to one cluster, so one batch can hold a parallel
+  // group's candidates for the whole population: the backend sees a few large
+  // batches per generation rather than one per cluster and group. Acceptance
+  // still runs cluster by cluster within each batch.
+  struct Member
+  {
+    std::size_t solution;
+    std::size_t cluster;
+    bool        anticipate;
+  };
+  std::vector<Member> members;
+  members.reserve(m_Population.size());
   for (std::size_t c = 0; c < clusters.size(); ++c)
   {
-    ClusterModel & cluster = clusters[c];
+    const ClusterModel & cluster = clusters[c];
     if (cluster.population.empty() || cluster.means.empty())
       continue;
-    std::vector<std::size_t> members = cluster.population;
-    for (std::size_t i = members.size(); i > 1; --i)
-      std::swap(members[i - 1], members[static_cast<std::size_t>(random.Uniform() * static_cast<double>(i))]);
-    const auto amsCount = static_cast<std::size_t>(amsFraction * static_cast<double>(members.size()));
-    for (std::size_t s : members)
-      solutionCluster[s] = cluster.singleObjective;
-
-    for (std::size_t g : groupOrder)
+    std::vector<std::size_t> order = cluster.population;
+    for (std::size_t i = order.size(); i > 1; --i)
+      std::swap(order[i - 1], order[static_cast<std::size_t>(random.Uniform() * static_cast<double>(i))]);
+    const auto amsCount = static_cast<std::size_t>(amsFraction * static_cast<double>(order.size()));
+    for (std::size_t j = 0; j < order.size(); ++j)
     {
-      std::vector<Candidate> candidates;
-      candidates.reserve(members.size() * m_Parallel.groups[g].size());
-      for (std::size_t j = 0; j < members.size(); ++j)
-        for (std::uint32_t e : m_Parallel.groups[g])
-        {
-          Candidate cand;
-          cand.solution = members[j];
-          cand.element = e;
-          cand.cluster = c;
-          cand.singleObjective = cluster.singleObjective;
-          cand.seed = random.NextU64();
-          cand.anticipate = j < amsCount;
-          candidates.push_back(std::move(cand));
-        }
-      const auto sampling = std::chrono::steady_clock::now();
-      SampleCandidates(candidates, cluster);
-      record.phaseSeconds.sampling += SecondsSince(sampling);
-      ProcessCandidates(candidates, record);
-      for (const Candidate & cand : candidates)
-        if (cand.accepted)
-        {
-          improved[cand.solution] = true;
-          auto & sum = acceptedSum[c][cand.element];
-          sum.resize(cand.sample.size(), 0.0);
-          for (std::size_t a = 0; a < sum.size(); ++a)
-            sum[a] += cand.sample[a];
-          ++acceptedCount[c][cand.element];
-        }
+      members.push_back({ order[j], c, j < amsCount });
+      solutionCluster[order[j]] = cluster.singleObjective;
     }
   }
+
+  for (std::size_t g : groupOrder)
+  {
+    std::vector<Candidate> candidates;
+    candidates.reserve(members.size() * m_Parallel.groups[g].size());
+    for (const Member & member : members)
+      for (std::uint32_t e : m_Parallel.groups[g])
+      {
+        Candidate cand;
+        cand.solution = member.solution;
+        cand.element = e;
+        cand.cluster = member.cluster;
+        cand.singleObjective = clusters[member.cluster].singleObjective;
+        cand.seed = random.NextU64();
+        cand.anticipate = member.anticipate;
+        candidates.push_back(std::move(cand));
+      }
+    const auto sampling = std::chrono::steady_clock::now();
+    SampleCandidates(candidates, clusters);
+    record.phaseSeconds.sampling += SecondsSince(sampling);
+    ProcessCandidates(candidates, record);
+    for (const Candidate & cand : candidates)
+      if (cand.accepted)
+      {
+        improved[cand.solution] = true;
+        auto & sum = acceptedSum[cand.cluster][cand.element];
+        sum.resize(cand.sample.size(), 0.0);
+        for (std::size_t a = 0; a < sum.size(); ++a)
+          sum[a] += cand.sample[a];
+        ++acceptedCount[cand.cluster][cand.element];
+      }
+  }
+  const auto bookkeeping = std::chrono::steady_clock::now();
+  double     forcedSeconds = 0.0;
 
   // Distribution multipliers (adaptive variance scaling with the
   // standard-deviation-ratio test and the no-improvement stretch).
@@ -936,7 +961,9 @@ MoRvGomea::RunGeneration()
     {
       const auto forced = std::chrono::steady_clock::now();
       ForcedImprovement(s, solutionCluster[s], random, record);
-      record.phaseSeconds.forcedImprovements += SecondsSince(forced);
+      const double seconds = SecondsSince(forced);
+      record.phaseSeconds.forcedImprovements += seconds;
+      forcedSeconds += seconds;
       m_NoImprovement[s] = 0;
     }
   }
@@ -947,8 +974,9 @@ MoRvGomea::RunGeneration()
     EvaluatePopulationFully();
     record.tetrahedronEvaluations += n * static_cast<double>(m_Topology.NumberOfTetrahedra());
   }
-  record.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   GenerationRecord summary = Summarise(m_Generation, record);
+  summary.phaseSeconds.bookkeeping = SecondsSince(bookkeeping) - forcedSeconds;
+  summary.seconds = SecondsSince(start);
   m_History.push_back(summary);
 }
 
