@@ -174,12 +174,13 @@ public:
 private:
   struct ClusterModel;
   struct Candidate;
+  struct CandidateBatch;
 
   /** Draws each candidate's variables (its solution, element, cluster and
    *  seed are set) from its cluster's distribution for its element, in
    *  parallel: each candidate has its own random stream. */
   void
-  SampleCandidates(std::vector<Candidate> & candidates, const std::vector<ClusterModel> & clusters);
+  SampleCandidates(CandidateBatch & batch, const std::vector<ClusterModel> & clusters);
 
   Fitness
   Steered(const Fitness & raw) const;
@@ -197,7 +198,7 @@ private:
   /** Repairs (when enabled) and evaluates `candidates`, then accepts them in
    *  order; returns how many were accepted. */
   std::size_t
-  ProcessCandidates(std::vector<Candidate> & candidates, GenerationRecord & record);
+  ProcessCandidates(CandidateBatch & batch, GenerationRecord & record);
   void
   ForcedImprovement(std::size_t solution, int singleObjective, RandomGenerator & random, GenerationRecord & record);
   bool
@@ -213,6 +214,7 @@ private:
   EvaluationBackend &       m_Backend;
   GomeaOptions              m_Options;
   std::unique_ptr<ThreadPool> m_Pool; ///< candidate sampling and fold checks
+  std::unique_ptr<CandidateBatch> m_Batch; ///< reused by every batch
 
   std::size_t                             m_Generation{ 0 };
   std::vector<DualMesh>                   m_Population;

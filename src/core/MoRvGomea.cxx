@@ -154,20 +154,74 @@ struct MoRvGomea::ClusterModel
   std::vector<std::size_t>         population; ///< solutions varied with this cluster's model
 };
 
-/** One partial change of one solution: an element's new coordinates. */
+/** One partial change of one solution: an element's new coordinates. Its
+ *  coordinates, drawn variables and values live in its CandidateBatch. */
 struct MoRvGomea::Candidate
 {
-  std::size_t                    solution{ 0 };
-  std::size_t                    element{ 0 };
-  int                            singleObjective{ -1 }; ///< acceptance rule: -1 Pareto, else that objective
-  bool                           forced{ false };       ///< forced improvement: must dominate the parent
-  std::uint64_t                  seed{ 0 };             ///< of its sampling and repair streams
-  bool                           anticipate{ false };   ///< add the anticipated mean shift
+  std::size_t   solution{ 0 };
+  std::size_t   element{ 0 };
+  int           singleObjective{ -1 }; ///< acceptance rule: -1 Pareto, else that objective
+  bool          forced{ false };       ///< forced improvement: must dominate the parent
+  std::uint64_t seed{ 0 };             ///< of its sampling and repair streams
+  bool          anticipate{ false };   ///< add the anticipated mean shift
+  std::size_t   cluster{ 0 };
+  bool          accepted{ false };
+  std::size_t   firstPoint{ 0 }; ///< in the batch's source/target (6 variables per point in samples)
+  std::size_t   firstValue{ 0 }; ///< in the batch's values
+};
+
+/** Candidates and the storage of their coordinates, drawn variables and
+ *  values, kept from batch to batch: a generation's hundreds of thousands
+ *  of candidates then cost no allocation each. */
+struct MoRvGomea::CandidateBatch
+{
+  std::vector<Candidate>         candidates;
   std::vector<Vec3>              source, target;
+  std::vector<double>            samples; ///< drawn variables (before projection), for the ratio test
   std::vector<TetrahedronValues> values;
-  std::vector<double>            sample; ///< the drawn variables (before projection), for the ratio test
-  std::size_t                    cluster{ 0 };
-  bool                           accepted{ false };
+
+  /** Places each candidate's data; storage only grows. */
+  void
+  Layout(const ParallelStructure & parallel)
+  {
+    std::size_t points = 0, values_ = 0;
+    for (Candidate & c : candidates)
+    {
+      const FosElement & element = parallel.elements[c.element];
+      c.firstPoint = points;
+      c.firstValue = values_;
+      points += element.points.size();
+      values_ += element.dependentTetrahedra.size();
+    }
+    if (source.size() < points)
+    {
+      source.resize(points);
+      target.resize(points);
+      samples.resize(6 * points);
+    }
+    if (values.size() < values_)
+      values.resize(values_);
+  }
+  Vec3 *
+  Source(const Candidate & c)
+  {
+    return source.data() + c.firstPoint;
+  }
+  Vec3 *
+  Target(const Candidate & c)
+  {
+    return target.data() + c.firstPoint;
+  }
+  double *
+  Sample(const Candidate & c)
+  {
+    return samples.data() + 6 * c.firstPoint;
+  }
+  TetrahedronValues *
+  Values(const Candidate & c)
+  {
+    return values.data() + c.firstValue;
+  }
 };
 
 MoRvGomea::MoRvGomea(const TetrahedralMesh & base, const MeshTopology & topology, const ParallelStructure & parallel,
@@ -190,6 +244,7 @@ MoRvGomea::MoRvGomea(const TetrahedralMesh & base, const MeshTopology & topology
     throw Error("optimiser: the mesh has no FOS elements");
   m_Archive = std::make_unique<ElitistArchive>(options.archiveCapacity);
   m_Pool = std::make_unique<ThreadPool>(options.threads);
+  m_Batch = std::make_unique<CandidateBatch>();
   FoldHandling folds;
   folds.constraint = &m_Constraint;
   folds.base = &m_Base;
@@ -586,10 +641,11 @@ MoRvGomea::EstimateDistributions(std::vector<ClusterModel> & clusters) const
 }
 
 void
-MoRvGomea::SampleCandidates(std::vector<Candidate> & candidates, const std::vector<ClusterModel> & clusters)
+MoRvGomea::SampleCandidates(CandidateBatch & batch, const std::vector<ClusterModel> & clusters)
 {
-  m_Pool->ParallelFor(candidates.size(), [&](std::size_t i) {
-    Candidate &                 cand = candidates[i];
+  batch.Layout(m_Parallel);
+  m_Pool->ParallelFor(batch.candidates.size(), [&](std::size_t i) {
+    Candidate &                 cand = batch.candidates[i];
     const ClusterModel &        cluster = clusters[cand.cluster];
     const FosElement &          element = m_Parallel.elements[cand.element];
     const std::size_t           dim = 6 * element.points.size();
@@ -597,9 +653,9 @@ MoRvGomea::SampleCandidates(std::vector<Candidate> & candidates, const std::vect
     const std::vector<double> & l = cluster.cholesky[cand.element];
     const DistributionState &   state = m_Distributions[cand.cluster][cand.element];
     RandomGenerator             random(HashCombine(cand.seed, SamplingStream));
-    std::vector<double>         z(dim);
-    std::vector<double> &       x = cand.sample;
-    x.resize(dim);
+    thread_local std::vector<double> z;
+    z.resize(dim);
+    double *                    x = batch.Sample(cand);
     for (auto & v : z)
       v = random.Normal();
     const double scale = std::sqrt(state.multiplier);
@@ -613,21 +669,22 @@ MoRvGomea::SampleCandidates(std::vector<Candidate> & candidates, const std::vect
     if (cand.anticipate && state.previousMean.size() == dim)
       for (std::size_t a = 0; a < dim; ++a)
         x[a] += AmsDelta * state.multiplier * (mean[a] - state.previousMean[a]);
-    cand.source.resize(element.points.size());
-    cand.target.resize(element.points.size());
+    Vec3 *                      source = batch.Source(cand);
+    Vec3 *                      target = batch.Target(cand);
     for (std::size_t k = 0; k < element.points.size(); ++k)
     {
       const std::uint32_t p = element.points[k];
-      cand.source[k] = ProjectToDomain({ { x[6 * k], x[6 * k + 1], x[6 * k + 2] } }, m_Base.pins[p], m_Base.domain);
-      cand.target[k] =
+      source[k] = ProjectToDomain({ { x[6 * k], x[6 * k + 1], x[6 * k + 2] } }, m_Base.pins[p], m_Base.domain);
+      target[k] =
         ProjectToDomain({ { x[6 * k + 3], x[6 * k + 4], x[6 * k + 5] } }, m_Base.pins[p], m_Base.domain);
     }
   });
 }
 
 std::size_t
-MoRvGomea::ProcessCandidates(std::vector<Candidate> & candidates, GenerationRecord & record)
+MoRvGomea::ProcessCandidates(CandidateBatch & candidateBatch, GenerationRecord & record)
 {
+  std::vector<Candidate> & candidates = candidateBatch.candidates;
   // 1. Fold checks (and repair) and evaluation of the whole batch at once,
   //    in the backend (the GPU checks where the points already are). A
   //    candidate still folded cannot replace a fold-free parent: it needs no
@@ -637,14 +694,12 @@ MoRvGomea::ProcessCandidates(std::vector<Candidate> & candidates, GenerationReco
   for (std::size_t i = 0; i < candidates.size(); ++i)
   {
     Candidate &        c = candidates[i];
-    const FosElement & element = m_Parallel.elements[c.element];
-    c.values.resize(element.dependentTetrahedra.size());
     PartialCandidate & p = batch[i];
     p.parent = &m_Population[c.solution];
-    p.element = &element;
-    p.source = c.source.data();
-    p.target = c.target.data();
-    p.values = c.values.data();
+    p.element = &m_Parallel.elements[c.element];
+    p.source = candidateBatch.Source(c);
+    p.target = candidateBatch.Target(c);
+    p.values = candidateBatch.Values(c);
     p.folds = &folds[i];
     p.seed = c.seed;
     p.evaluateFolded = std::llround(m_Totals[c.solution].sum.folded) != 0;
@@ -689,12 +744,13 @@ MoRvGomea::ProcessCandidates(std::vector<Candidate> & candidates, GenerationReco
     {
       const Candidate &  c = candidates[batchIndex[b]];
       const FosElement & element = m_Parallel.elements[c.element];
-      const auto &       stored = m_TetValues[c.solution];
-      ObjectiveTotals    change;
+      const auto &              stored = m_TetValues[c.solution];
+      const TetrahedronValues * values = candidateBatch.Values(c);
+      ObjectiveTotals           change;
       for (std::size_t k = 0; k < element.dependentTetrahedra.size(); ++k)
       {
         change.Add(stored[element.dependentTetrahedra[k]], -1.0);
-        change.Add(c.values[k]);
+        change.Add(values[k]);
       }
       changes[b] = change.sum;
       ObjectiveTotals totals = m_Totals[c.solution];
@@ -734,14 +790,17 @@ MoRvGomea::ProcessCandidates(std::vector<Candidate> & candidates, GenerationReco
       accept = ConstraintDominates(next, now) || m_Archive->Accepts(next, verdict);
     if (!accept)
       continue;
-    DualMesh & solution = m_Population[s];
+    DualMesh &                solution = m_Population[s];
+    const Vec3 *              source = candidateBatch.Source(c);
+    const Vec3 *              target = candidateBatch.Target(c);
+    const TetrahedronValues * values = candidateBatch.Values(c);
     for (std::size_t k = 0; k < element.points.size(); ++k)
     {
-      solution.source[element.points[k]] = c.source[k];
-      solution.target[element.points[k]] = c.target[k];
+      solution.source[element.points[k]] = source[k];
+      solution.target[element.points[k]] = target[k];
     }
     for (std::size_t k = 0; k < element.dependentTetrahedra.size(); ++k)
-      m_TetValues[s][element.dependentTetrahedra[k]] = c.values[k];
+      m_TetValues[s][element.dependentTetrahedra[k]] = values[k];
     m_Totals[s] = totals;
     changed[s] = true;
     m_Ids[s] = m_NextId++;
@@ -768,9 +827,10 @@ MoRvGomea::ForcedImprovement(std::size_t s, int singleObjective, RandomGenerator
   const DualMesh donorMesh = entries[donor].solution; // a copy: accepting may change the archive
   ++record.forcedImprovements;
   std::size_t accepted = 0;
+  CandidateBatch & batch = *m_Batch;
   for (const auto & group : m_Parallel.groups)
   {
-    std::vector<Candidate> candidates;
+    batch.candidates.clear();
     for (std::uint32_t e : group)
     {
       Candidate c;
@@ -778,14 +838,19 @@ MoRvGomea::ForcedImprovement(std::size_t s, int singleObjective, RandomGenerator
       c.element = e;
       c.forced = true;
       c.seed = random.NextU64();
-      for (std::uint32_t p : m_Parallel.elements[e].points)
-      {
-        c.source.push_back(donorMesh.source[p]);
-        c.target.push_back(donorMesh.target[p]);
-      }
-      candidates.push_back(std::move(c));
+      batch.candidates.push_back(c);
     }
-    accepted += ProcessCandidates(candidates, record);
+    batch.Layout(m_Parallel);
+    for (const Candidate & c : batch.candidates)
+    {
+      const auto & points = m_Parallel.elements[c.element].points;
+      for (std::size_t k = 0; k < points.size(); ++k)
+      {
+        batch.Source(c)[k] = donorMesh.source[points[k]];
+        batch.Target(c)[k] = donorMesh.target[points[k]];
+      }
+    }
+    accepted += ProcessCandidates(batch, record);
   }
   if (accepted == 0)
   {
@@ -872,10 +937,11 @@ MoRvGomea::RunGeneration()
     }
   }
 
+  CandidateBatch & batch = *m_Batch;
   for (std::size_t g : groupOrder)
   {
-    std::vector<Candidate> candidates;
-    candidates.reserve(members.size() * m_Parallel.groups[g].size());
+    std::vector<Candidate> & candidates = batch.candidates;
+    candidates.clear();
     for (const Member & member : members)
       for (std::uint32_t e : m_Parallel.groups[g])
       {
@@ -886,20 +952,21 @@ MoRvGomea::RunGeneration()
         cand.singleObjective = clusters[member.cluster].singleObjective;
         cand.seed = random.NextU64();
         cand.anticipate = member.anticipate;
-        candidates.push_back(std::move(cand));
+        candidates.push_back(cand);
       }
     const auto sampling = std::chrono::steady_clock::now();
-    SampleCandidates(candidates, clusters);
+    SampleCandidates(batch, clusters);
     record.phaseSeconds.sampling += SecondsSince(sampling);
-    ProcessCandidates(candidates, record);
+    ProcessCandidates(batch, record);
     for (const Candidate & cand : candidates)
       if (cand.accepted)
       {
         improved[cand.solution] = true;
-        auto & sum = acceptedSum[cand.cluster][cand.element];
-        sum.resize(cand.sample.size(), 0.0);
+        auto &         sum = acceptedSum[cand.cluster][cand.element];
+        const double * sample = batch.Sample(cand);
+        sum.resize(6 * m_Parallel.elements[cand.element].points.size(), 0.0);
         for (std::size_t a = 0; a < sum.size(); ++a)
-          sum[a] += cand.sample[a];
+          sum[a] += sample[a];
         ++acceptedCount[cand.cluster][cand.element];
       }
   }
