@@ -39,12 +39,20 @@ public:
   {
     m_Cpu->EvaluateSolutions(s, v);
   }
+  using EvaluationBackend::EvaluatePartials;
   void
-  EvaluatePartials(const std::vector<PartialCandidate> & candidates) override
+  EvaluatePartials(const std::vector<PartialCandidate> & candidates, const ReadyCandidates & ready) override
   {
     std::vector<PartialCandidate> shuffled = candidates;
     std::shuffle(shuffled.begin(), shuffled.end(), m_Random);
     m_Cpu->EvaluatePartials(shuffled);
+    // Handed over in parts of random sizes, as a device backend may.
+    for (std::size_t begin = 0; ready && begin < candidates.size();)
+    {
+      const std::size_t end = std::min(candidates.size(), begin + 1 + m_Random() % 64);
+      ready(begin, end);
+      begin = end;
+    }
   }
   void
   SetFoldHandling(const FoldHandling & handling) override

@@ -12,6 +12,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -72,6 +73,11 @@ struct BackendStatistics
   double        seconds{ 0.0 };     ///< wall time inside the calls
   double        kernelSeconds{ 0.0 }; ///< device time of the kernels (CUDA only)
   double        foldSeconds{ 0.0 };   ///< of the calls' time, fold checks and repair (CUDA: device time)
+  // CUDA only, host time of the partial evaluations: packing and uploading a
+  // batch, waiting for the device, handing the results back.
+  double stagingSeconds{ 0.0 };
+  double waitSeconds{ 0.0 };
+  double unpackSeconds{ 0.0 };
 };
 
 class EvaluationBackend
@@ -95,10 +101,24 @@ public:
   EvaluateSolutions(const std::vector<const DualMesh *> & solutions,
                     const std::vector<std::vector<TetrahedronValues> *> & values) = 0;
 
+  /** Told that candidates [begin, end) of an EvaluatePartials call have their
+   *  values and fold outcomes. */
+  using ReadyCandidates = std::function<void(std::size_t begin, std::size_t end)>;
+
   /** The dependent tetrahedra of every candidate, each with its moved points;
    *  fold checks first where asked for (SetFoldHandling). */
+  void
+  EvaluatePartials(const std::vector<PartialCandidate> & candidates)
+  {
+    EvaluatePartials(candidates, ReadyCandidates{});
+  }
+
+  /** As above, calling `ready` (if set) for consecutive ranges that cover all
+   *  candidates, in order, before returning. A backend that evaluates in
+   *  parts (CUDA) calls it as each part is done, so the caller works on the
+   *  first candidates while the device computes the rest. */
   virtual void
-  EvaluatePartials(const std::vector<PartialCandidate> & candidates) = 0;
+  EvaluatePartials(const std::vector<PartialCandidate> & candidates, const ReadyCandidates & ready) = 0;
 
   /** Fold checks and repair of later EvaluatePartials calls; the constraint
    *  and base mesh must outlive them. */

@@ -199,6 +199,13 @@ private:
    *  order; returns how many were accepted. */
   std::size_t
   ProcessCandidates(CandidateBatch & batch, GenerationRecord & record);
+  /** The acceptance step of ProcessCandidates for candidates [begin, end),
+   *  which have their values; `changed` marks solutions changed since their
+   *  verdicts were taken. */
+  std::size_t
+  AcceptCandidates(CandidateBatch & candidateBatch, const std::vector<PartialCandidate> & batch,
+                   const std::vector<CandidateFolds> & folds, std::size_t begin, std::size_t end,
+                   std::vector<bool> & changed, GenerationRecord & record);
   void
   ForcedImprovement(std::size_t solution, int singleObjective, RandomGenerator & random, GenerationRecord & record);
   bool

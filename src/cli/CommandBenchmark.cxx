@@ -73,6 +73,10 @@ TimeBackend(const std::string & name, const itk::morea::MeshModel & model, const
                               { "seconds", seconds },
                               { "backend_seconds", after.seconds - before.seconds },
                               { "kernel_seconds", after.kernelSeconds - before.kernelSeconds },
+                              { "backend_host_seconds",
+                                { { "staging", after.stagingSeconds - before.stagingSeconds },
+                                  { "waiting", after.waitSeconds - before.waitSeconds },
+                                  { "unpacking", after.unpackSeconds - before.unpackSeconds } } },
                               { "tetrahedra", after.tetrahedra - before.tetrahedra },
                               { "samples", after.samples - before.samples },
                               { "batches", after.batches - before.batches },
@@ -93,7 +97,9 @@ TimeBackend(const std::string & name, const itk::morea::MeshModel & model, const
                                   { "bookkeeping", r.phaseSeconds.bookkeeping } } } });
     std::cout << "    generation " << r.generation << ": " << std::fixed << std::setprecision(3) << seconds
               << " s (backend " << after.seconds - before.seconds << " s, kernels "
-              << after.kernelSeconds - before.kernelSeconds << " s; sampling " << r.phaseSeconds.sampling
+              << after.kernelSeconds - before.kernelSeconds << " s, staging "
+              << after.stagingSeconds - before.stagingSeconds << ", waiting " << after.waitSeconds - before.waitSeconds
+              << ", unpacking " << after.unpackSeconds - before.unpackSeconds << "; sampling " << r.phaseSeconds.sampling
               << ", folds " << r.phaseSeconds.foldChecks << ", acceptance " << r.phaseSeconds.acceptance
               << ", forced " << r.phaseSeconds.forcedImprovements << ", modelling " << r.phaseSeconds.modelling
               << ", bookkeeping " << r.phaseSeconds.bookkeeping << "), best guidance " << std::defaultfloat

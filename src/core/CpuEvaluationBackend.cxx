@@ -129,8 +129,9 @@ public:
     m_Statistics.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
 
+  using EvaluationBackend::EvaluatePartials;
   void
-  EvaluatePartials(const std::vector<PartialCandidate> & candidates) override
+  EvaluatePartials(const std::vector<PartialCandidate> & candidates, const ReadyCandidates & ready) override
   {
     const auto   start = std::chrono::steady_clock::now();
     const auto & tets = m_Evaluator.Topology().Tetrahedra();
@@ -169,6 +170,8 @@ public:
         m_Statistics.samples += c.values[k].samples;
     }
     m_Statistics.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (ready)
+      ready(0, candidates.size());
   }
 
 private:

@@ -704,16 +704,35 @@ MoRvGomea::ProcessCandidates(CandidateBatch & candidateBatch, GenerationRecord &
     p.seed = c.seed;
     p.evaluateFolded = std::llround(m_Totals[c.solution].sum.folded) != 0;
   }
+  // 2. Acceptance of each part of the batch as the backend hands it over
+  //    (in order), while the device may still compute the next part.
+  std::vector<bool> changed(m_Population.size(), false);
+  std::size_t       accepted = 0;
+  double            acceptanceSeconds = 0.0;
+  const auto        accept = [&](std::size_t begin, std::size_t end) {
+    const auto phaseStart = std::chrono::steady_clock::now();
+    accepted += AcceptCandidates(candidateBatch, batch, folds, begin, end, changed, record);
+    acceptanceSeconds += SecondsSince(phaseStart);
+  };
   const BackendStatistics before = m_Backend.Statistics();
-  auto                    phaseStart = std::chrono::steady_clock::now();
-  m_Backend.EvaluatePartials(batch);
+  const auto              evaluationStart = std::chrono::steady_clock::now();
+  m_Backend.EvaluatePartials(batch, accept);
   const double foldSeconds = m_Backend.Statistics().foldSeconds - before.foldSeconds;
   record.phaseSeconds.foldChecks += foldSeconds;
-  record.phaseSeconds.evaluation += SecondsSince(phaseStart) - foldSeconds;
-  phaseStart = std::chrono::steady_clock::now();
+  record.phaseSeconds.evaluation += SecondsSince(evaluationStart) - foldSeconds - acceptanceSeconds;
+  record.phaseSeconds.acceptance += acceptanceSeconds;
+  record.accepted += accepted;
+  return accepted;
+}
 
+std::size_t
+MoRvGomea::AcceptCandidates(CandidateBatch & candidateBatch, const std::vector<PartialCandidate> & batch,
+                            const std::vector<CandidateFolds> & folds, std::size_t begin, std::size_t end,
+                            std::vector<bool> & changed, GenerationRecord & record)
+{
+  std::vector<Candidate> & candidates = candidateBatch.candidates;
   std::vector<std::size_t> batchIndex;
-  for (std::size_t i = 0; i < candidates.size(); ++i)
+  for (std::size_t i = begin; i < end; ++i)
   {
     Candidate & c = candidates[i];
     ++record.candidates;
@@ -759,8 +778,11 @@ MoRvGomea::ProcessCandidates(CandidateBatch & candidateBatch, GenerationRecord &
       witness = verdicts[b].witness;
     }
   });
-  std::vector<bool> changed(m_Population.size(), false);
-  std::size_t       accepted = 0;
+  // Verdicts are taken after the earlier parts' acceptances: only changes
+  // within this part make them stale.
+  for (std::size_t b = 0; b < batchIndex.size(); ++b)
+    changed[candidates[batchIndex[b]].solution] = false;
+  std::size_t accepted = 0;
   for (std::size_t b = 0; b < batchIndex.size(); ++b)
   {
     Candidate &        c = candidates[batchIndex[b]];
@@ -808,8 +830,6 @@ MoRvGomea::ProcessCandidates(CandidateBatch & candidateBatch, GenerationRecord &
     c.accepted = true;
     ++accepted;
   }
-  record.accepted += accepted;
-  record.phaseSeconds.acceptance += SecondsSince(phaseStart);
   return accepted;
 }
 

@@ -306,6 +306,10 @@ SampleChunk(const SamplingConstants & k, const SampleTask * __restrict__ tasks,
   std::uint32_t       laneState[4];
   SobolLaneState(shifts, lane, c_SobolDirections, laneState);
 
+  // One sample per lane and iteration: two per iteration, their four
+  // intensity fetches in flight together, measured 8 % slower on an H100
+  // (0.286-0.290 against 0.265 s of kernels per generation, with 2-4
+  // resident blocks per SM).
   float               intensity = 0.0f, guidance = 0.0f;
   const std::uint32_t firstJ = local * k.chunkIterations;
   for (std::uint32_t j = firstJ; j < firstJ + k.chunkIterations && 32 * j < n; ++j)
