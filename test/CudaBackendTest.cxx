@@ -197,6 +197,49 @@ TEST(CudaEvaluationBackend, PartialCandidatesAgreeWithTheCpu)
   const Fitness fa = ta.ToFitness(count), fc = tc.ToFitness(count);
   for (std::size_t m = 0; m < NumberOfObjectives; ++m)
     ExpectRelativelyClose(fa.objectives[m], fc.objectives[m], 1e-2, "texture objective " + std::to_string(m));
+
+  // A batch large enough to run in parts (the same candidates many times):
+  // every part is handed over once, in order, and each copy gets exactly the
+  // values of the small batch, whichever part it was sampled in.
+  std::size_t smallItems = 0;
+  for (const auto & v : c)
+    smallItems += v.size();
+  const std::size_t                           copies = 1000000 / std::max<std::size_t>(1, smallItems) + 1;
+  std::vector<PartialCandidate>               large;
+  std::vector<std::vector<TetrahedronValues>> l(copies * candidates.size());
+  for (std::size_t k = 0; k < copies; ++k)
+    for (std::size_t i = 0; i < candidates.size(); ++i)
+    {
+      large.push_back(candidates[i]);
+      l[large.size() - 1].resize(candidates[i].element->dependentTetrahedra.size());
+      large.back().values = l[large.size() - 1].data();
+    }
+  std::vector<std::pair<std::size_t, std::size_t>> handed;
+  CreateCudaEvaluationBackend(*problem.evaluator, 2, CudaInterpolation::Texture)
+    ->EvaluatePartials(large, [&](std::size_t begin, std::size_t end) {
+      // Every earlier candidate already has its values when a part is handed over.
+      if (begin > 0 && !l[begin - 1].empty())
+        EXPECT_EQ(l[begin - 1][0].samples, c[(begin - 1) % candidates.size()][0].samples);
+      handed.emplace_back(begin, end);
+    });
+  ASSERT_GT(handed.size(), 1u) << "the batch was not split";
+  std::size_t next = 0;
+  for (const auto & [begin, end] : handed)
+  {
+    EXPECT_EQ(begin, next);
+    EXPECT_LT(begin, end);
+    next = end;
+  }
+  EXPECT_EQ(next, large.size());
+  for (std::size_t j = 0; j < large.size(); ++j)
+    for (std::size_t t = 0; t < l[j].size(); ++t)
+    {
+      const TetrahedronValues & expected = c[j % candidates.size()][t];
+      ASSERT_EQ(l[j][t].intensity, expected.intensity) << "copy " << j / candidates.size() << ", candidate " << j % candidates.size();
+      ASSERT_EQ(l[j][t].guidance, expected.guidance);
+      ASSERT_EQ(l[j][t].samples, expected.samples);
+      ASSERT_EQ(l[j][t].magnitude, expected.magnitude);
+    }
 }
 
 TEST(CudaEvaluationBackend, VolumeBoundFoldsAgreeWithTheCpu)
