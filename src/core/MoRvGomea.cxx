@@ -184,23 +184,23 @@ struct MoRvGomea::CandidateBatch
   void
   Layout(const ParallelStructure & parallel)
   {
-    std::size_t points = 0, values_ = 0;
+    std::size_t pointCount = 0, valueCount = 0;
     for (Candidate & c : candidates)
     {
       const FosElement & element = parallel.elements[c.element];
-      c.firstPoint = points;
-      c.firstValue = values_;
-      points += element.points.size();
-      values_ += element.dependentTetrahedra.size();
+      c.firstPoint = pointCount;
+      c.firstValue = valueCount;
+      pointCount += element.points.size();
+      valueCount += element.dependentTetrahedra.size();
     }
-    if (source.size() < points)
+    if (source.size() < pointCount)
     {
-      source.resize(points);
-      target.resize(points);
-      samples.resize(6 * points);
+      source.resize(pointCount);
+      target.resize(pointCount);
+      samples.resize(6 * pointCount);
     }
-    if (values.size() < values_)
-      values.resize(values_);
+    if (values.size() < valueCount)
+      values.resize(valueCount);
   }
   Vec3 *
   Source(const Candidate & c)

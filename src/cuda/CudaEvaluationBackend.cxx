@@ -121,7 +121,7 @@ public:
     });
     CopyCornersToDevice(solutions.size() * n);
     Run(solutions.size() * n);
-    std::vector<std::size_t> first(solutions.size() + 1);
+    std::vector<std::uint64_t> first(solutions.size() + 1);
     for (std::size_t s = 0; s <= solutions.size(); ++s)
       first[s] = s * n;
     for (auto * v : values)
@@ -186,16 +186,15 @@ public:
       Reserve(items);
       cuda::LaunchGatherCandidateCorners(m_Batch, items, m_Corners.Data(), m_Tetrahedra.Data(), m_Stream->Get());
     }
-    std::vector<std::size_t> first(candidates.size() + 1, 0);
-    for (std::size_t i = 0; i < candidates.size(); ++i)
-      first[i + 1] = first[i] + candidates[i].element->dependentTetrahedra.size();
+    // Each candidate's first item, as staged by UploadCandidates.
+    const std::uint64_t * first = m_HostFirstItem.Data();
     // Parts of whole candidates with about equal numbers of items.
     const std::size_t        parts = std::clamp<std::size_t>(items / MinItemsPerPart, 1, MaxParts);
     std::vector<std::size_t> candidateBounds{ 0 }, itemBounds{ 0 };
     for (std::size_t p = 1; p < parts; ++p)
     {
-      const auto it = std::lower_bound(first.begin(), first.end(), p * items / parts);
-      const auto c = static_cast<std::size_t>(it - first.begin());
+      const auto it = std::lower_bound(first, first + candidates.size() + 1, p * items / parts);
+      const auto c = static_cast<std::size_t>(it - first);
       if (c > candidateBounds.back() && c < candidates.size())
       {
         candidateBounds.push_back(c);
@@ -659,15 +658,15 @@ private:
    *  pool, counting the samples on the way. */
   template <typename Output>
   void
-  UnpackAll(const std::vector<std::size_t> & first, Output out)
+  UnpackAll(const std::vector<std::uint64_t> & first, Output out)
   {
-    UnpackRange(first, 0, first.size() - 1, out);
+    UnpackRange(first.data(), 0, first.size() - 1, out);
   }
 
   /** UnpackAll for groups [begin, end) only. */
   template <typename Output>
   void
-  UnpackRange(const std::vector<std::size_t> & first, std::size_t begin, std::size_t end, Output out)
+  UnpackRange(const std::uint64_t * first, std::size_t begin, std::size_t end, Output out)
   {
     std::vector<double> samples(end - begin, 0.0);
     m_Pool.ParallelFor(end - begin, [&](std::size_t g) {
