@@ -153,6 +153,111 @@ DistanceToSurroundingPolyhedron(const FoldRepairConstants & k, const SideView & 
   return n ? Div(sum, static_cast<double>(n)) : 0.0;
 }
 
+/** The tetrahedra around one point as the repair's trials see them: every
+ *  corner but the point itself stays where it is while the point's 64 trial
+ *  positions are tried, so the lanes gather the corners into shared memory
+ *  once (one tetrahedron each) and every trial then reads them with
+ *  broadcast loads, instead of following tetrahedron -> point -> element ->
+ *  position through global memory for each corner of each trial. The values
+ *  and the order of the sums are those of the uncached path. */
+constexpr std::uint32_t MaxStarTetrahedra = 64;
+
+struct PointStar
+{
+  double        corners[MaxStarTetrahedra][12];
+  double        referenceVolume[MaxStarTetrahedra];
+  std::uint8_t  slot[MaxStarTetrahedra]; ///< where the point is among the 4 corners
+  std::uint32_t count;
+};
+
+/** Fills `star` for point p (whose tetrahedra number at most MaxStarTetrahedra). */
+__device__ void
+GatherStar(const FoldRepairConstants & k, const SideView & s, std::uint32_t p, unsigned lane, PointStar & star)
+{
+  const std::uint32_t first = k.pointTetrahedronOffsets[p];
+  const std::uint32_t count = k.pointTetrahedronOffsets[p + 1] - first;
+  __syncwarp(); // no lane still reads the previous point's star
+  for (std::uint32_t i = lane; i < count; i += 32)
+  {
+    const std::uint32_t t = k.pointTetrahedra[first + i];
+    for (int j = 0; j < 4; ++j)
+    {
+      const std::uint32_t v = s.tetrahedra[4 * static_cast<std::size_t>(t) + j];
+      if (v == p)
+        star.slot[i] = static_cast<std::uint8_t>(j);
+      const double * x = s.Point(v);
+      for (int a = 0; a < 3; ++a)
+        star.corners[i][3 * j + a] = x[a];
+    }
+    star.referenceVolume[i] = k.referenceVolumes[t];
+  }
+  if (lane == 0)
+    star.count = count;
+  __syncwarp();
+}
+
+/** PointViolation from the star, the point at `position`. */
+__device__ bool
+StarViolation(const FoldRepairConstants & k, const PointStar & star, const double * position, double bound,
+              double & value, std::uint32_t & folded)
+{
+  value = 0.0;
+  folded = 0;
+  for (std::uint32_t i = 0; i < star.count; ++i)
+  {
+    double corners[12];
+    const int slot = star.slot[i];
+#pragma unroll
+    for (int c = 0; c < 12; ++c)
+      corners[c] = star.corners[i][c];
+#pragma unroll
+    for (int j = 0; j < 4; ++j)
+      if (j == slot)
+#pragma unroll
+        for (int a = 0; a < 3; ++a)
+          corners[3 * j + a] = position[a];
+    double count = 0.0;
+    value = Add(value, device::VolumeViolation(device::SignedVolume(corners), star.referenceVolume[i],
+                                               k.volumeFraction, count));
+    folded += count > 0.0;
+    if (value > bound)
+      return false;
+  }
+  return true;
+}
+
+/** DistanceToSurroundingPolyhedron from the star. */
+__device__ double
+StarDistance(const PointStar & star, const double * x)
+{
+  double        sum = 0.0;
+  std::uint32_t n = 0;
+  for (std::uint32_t i = 0; i < star.count; ++i)
+  {
+    const double * f[3];
+    int            m = 0;
+    for (int j = 0; j < 4; ++j)
+      if (j != star.slot[i])
+        f[m++] = star.corners[i] + 3 * j;
+    double u[3], w[3], d[3];
+    for (int a = 0; a < 3; ++a)
+    {
+      u[a] = Sub(f[1][a], f[0][a]);
+      w[a] = Sub(f[2][a], f[0][a]);
+      d[a] = Sub(x[a], f[0][a]);
+    }
+    const double normal[3] = { Sub(Mul(u[1], w[2]), Mul(u[2], w[1])), Sub(Mul(u[2], w[0]), Mul(u[0], w[2])),
+                               Sub(Mul(u[0], w[1]), Mul(u[1], w[0])) };
+    const double area2 =
+      sqrt(Add(Add(Mul(normal[0], normal[0]), Mul(normal[1], normal[1])), Mul(normal[2], normal[2])));
+    if (area2 == 0.0)
+      continue;
+    sum = Add(sum, Div(fabs(Add(Add(Mul(normal[0], d[0]), Mul(normal[1], d[1])), Mul(normal[2], d[2]))), area2));
+    ++n;
+  }
+  return n ? Div(sum, static_cast<double>(n)) : 0.0;
+}
+
 /** Trial `trial` of point p (pin `pin`) around `original`, in the domain. */
 __device__ void
 TrialPosition(const FoldRepairConstants & k, std::uint64_t seed, std::uint32_t round, std::uint32_t p,
@@ -170,7 +275,7 @@ TrialPosition(const FoldRepairConstants & k, std::uint64_t seed, std::uint32_t r
 /** RepairPoints over one side; true when it ends fold-free. */
 __device__ bool
 RepairSide(const FoldRepairConstants & k, const SideView & s, const std::uint32_t * dependent, std::uint32_t n,
-           std::uint64_t seed, unsigned lane)
+           std::uint64_t seed, unsigned lane, PointStar & star)
 {
   for (std::uint32_t round = 0; round < k.maxRounds; ++round)
   {
@@ -216,16 +321,25 @@ RepairSide(const FoldRepairConstants & k, const SideView & s, const std::uint32_
       const std::int8_t * pin = k.pins + 3 * static_cast<std::size_t>(p);
       if (pin[0] != 0 && pin[1] != 0 && pin[2] != 0)
         continue; // corners never move
+      // Every lane computes the same current value and scale; the trials
+      // are spread over the lanes.
+      const bool    cached = k.pointTetrahedronOffsets[p + 1] - k.pointTetrahedronOffsets[p] <= MaxStarTetrahedra;
+      double *      position = s.moved + 6 * next;
+      double        original[3] = { position[0], position[1], position[2] };
       double        currentValue = 0.0;
       std::uint32_t currentFolded = 0;
-      PointViolation(k, s, p, nullptr, INFINITY, currentValue, currentFolded);
+      if (cached)
+      {
+        GatherStar(k, s, p, lane, star);
+        StarViolation(k, star, original, INFINITY, currentValue, currentFolded);
+      }
+      else
+        PointViolation(k, s, p, nullptr, INFINITY, currentValue, currentFolded);
       if (currentFolded == 0)
         continue; // fixed by an earlier move in this pass
-      const double scale = DistanceToSurroundingPolyhedron(k, s, p);
+      const double scale = cached ? StarDistance(star, original) : DistanceToSurroundingPolyhedron(k, s, p);
       if (!(scale > 0.0))
         continue;
-      double * position = s.moved + 6 * next;
-      double   original[3] = { position[0], position[1], position[2] };
 
       // Each lane: the first of its trials with the lowest (value, folded),
       // if below the current; then the lowest over the lanes, ties to the
@@ -239,8 +353,9 @@ RepairSide(const FoldRepairConstants & k, const SideView & s, const std::uint32_
         TrialPosition(k, seed, round, p, trial, original, scale, pin, candidate);
         double        value = 0.0;
         std::uint32_t folded = 0;
-        if (PointViolation(k, s, p, candidate, bestValue, value, folded) &&
-            (value < bestValue || (value <= bestValue && folded < bestFolded)))
+        const bool    within = cached ? StarViolation(k, star, candidate, bestValue, value, folded)
+                                      : PointViolation(k, s, p, candidate, bestValue, value, folded);
+        if (within && (value < bestValue || (value <= bestValue && folded < bestFolded)))
         {
           bestValue = value;
           bestFolded = folded;
@@ -286,6 +401,7 @@ __global__ void
 CheckCandidateFolds(CandidateBatch b, FoldRepairConstants k, const std::uint8_t * check,
                     const std::uint64_t * sideSeeds, double * moved, std::uint8_t * outcome)
 {
+  __shared__ PointStar stars[RepairThreads / 32];
   const std::size_t warp = (static_cast<std::size_t>(blockIdx.x) * blockDim.x + threadIdx.x) / 32;
   const unsigned    lane = threadIdx.x % 32;
   if (warp >= 2 * b.candidates)
@@ -309,7 +425,7 @@ CheckCandidateFolds(CandidateBatch b, FoldRepairConstants k, const std::uint8_t 
   if (AnyFolded(k, s, dependent, n, lane))
   {
     result = SideFolded;
-    if (k.repair && RepairSide(k, s, dependent, n, sideSeeds[2 * c + side], lane))
+    if (k.repair && RepairSide(k, s, dependent, n, sideSeeds[2 * c + side], lane, stars[threadIdx.x / 32]))
       result |= SideRepaired;
   }
   if (lane == 0)
