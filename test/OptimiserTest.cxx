@@ -89,7 +89,18 @@ TEST(MoRvGomea, ArchiveHoldsOnlyMutuallyNonDominatedFoldFreeSolutions)
   const GomeaOptions   options = problem.Options(5, 10);
   MoRvGomea optimiser(problem.base, problem.topology, problem.parallel, *problem.constraint, *backend, options);
   optimiser.Initialize(problem.InitialPopulation(options));
+  const double initialSamples = backend->Statistics().samples;
   optimiser.Run();
+  // The records account for every sample of the partial evaluations; the
+  // CPU backend has no device time.
+  double recordedSamples = 0.0;
+  for (const GenerationRecord & r : optimiser.History())
+  {
+    EXPECT_EQ(r.deviceKernelSeconds, 0.0);
+    recordedSamples += r.samples;
+  }
+  EXPECT_GT(optimiser.History().back().samples, 0.0);
+  EXPECT_DOUBLE_EQ(recordedSamples, backend->Statistics().samples - initialSamples);
   const auto & entries = optimiser.Archive().Entries();
   ASSERT_GT(entries.size(), 2u);
   EXPECT_LE(entries.size(), options.archiveCapacity);

@@ -90,6 +90,11 @@ struct GenerationRecord
     double modelling{ 0.0 };   ///< steering, selection, clustering and estimation
     double bookkeeping{ 0.0 }; ///< multipliers, periodic full evaluation and the summary
   } phaseSeconds;
+  /** The backend's device time in this generation (the evaluation kernels;
+   *  0 on the CPU backend) and its sample points, both directions: the
+   *  kernels' share of the generation and their throughput. */
+  double deviceKernelSeconds{ 0.0 };
+  double samples{ 0.0 };
 };
 
 /** Per cluster and FOS element: what carries over between generations. */

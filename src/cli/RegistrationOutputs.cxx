@@ -75,6 +75,9 @@ ProgressPrinter()
       std::snprintf(line + std::strlen(line), sizeof line - std::strlen(line),
                     " (evaluation %.2f, folds %.2f, acceptance %.2f, sampling %.2f, modelling %.2f, other %.2f)",
                     p.evaluation, p.foldChecks, p.acceptance, p.sampling, p.modelling, p.bookkeeping);
+      if (r.deviceKernelSeconds > 0.0)
+        std::snprintf(line + std::strlen(line), sizeof line - std::strlen(line), ", device kernels %.2f s",
+                      r.deviceKernelSeconds);
       std::cout << line << "\n" << std::flush;
     }
   };
@@ -122,14 +125,15 @@ WriteRegistrationOutputs(const itk::morea::PreprocessResult & preprocessed,
   log.precision(10);
   log << "generation,hypervolume,best_guidance,archive_size,feasible,candidates,folded,accepted,repaired,forced_improvements,"
          "mean_multiplier,tetrahedron_evaluations,seconds,seconds_sampling,seconds_fold_checks,seconds_evaluation,"
-         "seconds_acceptance,seconds_forced_improvements,seconds_modelling,seconds_bookkeeping\n";
+         "seconds_acceptance,seconds_forced_improvements,seconds_modelling,seconds_bookkeeping,seconds_device_kernels,"
+         "samples\n";
   for (const auto & r : result.history)
     log << r.generation << "," << r.hypervolume << "," << r.bestGuidance << "," << r.archiveSize << "," << r.feasible
         << "," << r.candidates << "," << r.folded << "," << r.accepted << "," << r.repaired << "," << r.forcedImprovements << "," << r.meanMultiplier << ","
         << r.tetrahedronEvaluations << "," << r.seconds << "," << r.phaseSeconds.sampling << ","
         << r.phaseSeconds.foldChecks << "," << r.phaseSeconds.evaluation << "," << r.phaseSeconds.acceptance << ","
         << r.phaseSeconds.forcedImprovements << "," << r.phaseSeconds.modelling << "," << r.phaseSeconds.bookkeeping
-        << "\n";
+        << "," << r.deviceKernelSeconds << "," << r.samples << "\n";
   WriteTextFile(log.str(), out + "generations.csv");
 
   // The chosen solutions.

@@ -892,9 +892,10 @@ MoRvGomea::RunGeneration()
     throw Error("optimiser: Initialize() must come before RunGeneration()");
   if (Finished())
     throw Error("optimiser: all " + std::to_string(m_Options.generations) + " generations have run");
-  const auto       start = std::chrono::steady_clock::now();
-  GenerationRecord record;
-  RandomGenerator  random(HashCombine(m_Options.seed, static_cast<std::uint64_t>(m_Generation) + 1));
+  const auto              start = std::chrono::steady_clock::now();
+  const BackendStatistics backendBefore = m_Backend.Statistics();
+  GenerationRecord        record;
+  RandomGenerator         random(HashCombine(m_Options.seed, static_cast<std::uint64_t>(m_Generation) + 1));
 
   // Adaptive steering: after the exploration period only guidance values up
   // to threshold x the archive's best are kept (a hard constraint).
@@ -1064,6 +1065,8 @@ MoRvGomea::RunGeneration()
   GenerationRecord summary = Summarise(m_Generation, record);
   summary.phaseSeconds.bookkeeping = SecondsSince(bookkeeping) - forcedSeconds;
   summary.seconds = SecondsSince(start);
+  summary.deviceKernelSeconds = m_Backend.Statistics().kernelSeconds - backendBefore.kernelSeconds;
+  summary.samples = m_Backend.Statistics().samples - backendBefore.samples;
   m_History.push_back(summary);
 }
 
