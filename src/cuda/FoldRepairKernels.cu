@@ -116,6 +116,27 @@ PointViolation(const FoldRepairConstants & k, const SideView & s, std::uint32_t 
   return true;
 }
 
+/** Distance of x to the plane of face f (false for a degenerate face),
+ *  rounded as RepairPoints rounds it on the host. */
+__device__ bool
+FacePlaneDistance(const double * const f[3], const double * x, double & distance)
+{
+  double u[3], w[3], d[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    u[a] = Sub(f[1][a], f[0][a]);
+    w[a] = Sub(f[2][a], f[0][a]);
+    d[a] = Sub(x[a], f[0][a]);
+  }
+  const double normal[3] = { Sub(Mul(u[1], w[2]), Mul(u[2], w[1])), Sub(Mul(u[2], w[0]), Mul(u[0], w[2])),
+                             Sub(Mul(u[0], w[1]), Mul(u[1], w[0])) };
+  const double area2 = sqrt(Add(Add(Mul(normal[0], normal[0]), Mul(normal[1], normal[1])), Mul(normal[2], normal[2])));
+  if (area2 == 0.0)
+    return false;
+  distance = Div(fabs(Add(Add(Mul(normal[0], d[0]), Mul(normal[1], d[1])), Mul(normal[2], d[2]))), area2);
+  return true;
+}
+
 /** Mean distance of p to the planes of the faces opposite it. */
 __device__ double
 DistanceToSurroundingPolyhedron(const FoldRepairConstants & k, const SideView & s, std::uint32_t p)
@@ -134,20 +155,10 @@ DistanceToSurroundingPolyhedron(const FoldRepairConstants & k, const SideView & 
       if (v != p)
         f[m++] = s.Point(v);
     }
-    double u[3], w[3], d[3];
-    for (int a = 0; a < 3; ++a)
-    {
-      u[a] = Sub(f[1][a], f[0][a]);
-      w[a] = Sub(f[2][a], f[0][a]);
-      d[a] = Sub(x[a], f[0][a]);
-    }
-    const double normal[3] = { Sub(Mul(u[1], w[2]), Mul(u[2], w[1])), Sub(Mul(u[2], w[0]), Mul(u[0], w[2])),
-                               Sub(Mul(u[0], w[1]), Mul(u[1], w[0])) };
-    const double area2 =
-      sqrt(Add(Add(Mul(normal[0], normal[0]), Mul(normal[1], normal[1])), Mul(normal[2], normal[2])));
-    if (area2 == 0.0)
+    double distance = 0.0;
+    if (!FacePlaneDistance(f, x, distance))
       continue;
-    sum = Add(sum, Div(fabs(Add(Add(Mul(normal[0], d[0]), Mul(normal[1], d[1])), Mul(normal[2], d[2]))), area2));
+    sum = Add(sum, distance);
     ++n;
   }
   return n ? Div(sum, static_cast<double>(n)) : 0.0;
@@ -239,20 +250,10 @@ StarDistance(const PointStar & star, const double * x)
     for (int j = 0; j < 4; ++j)
       if (j != star.slot[i])
         f[m++] = star.corners[i] + 3 * j;
-    double u[3], w[3], d[3];
-    for (int a = 0; a < 3; ++a)
-    {
-      u[a] = Sub(f[1][a], f[0][a]);
-      w[a] = Sub(f[2][a], f[0][a]);
-      d[a] = Sub(x[a], f[0][a]);
-    }
-    const double normal[3] = { Sub(Mul(u[1], w[2]), Mul(u[2], w[1])), Sub(Mul(u[2], w[0]), Mul(u[0], w[2])),
-                               Sub(Mul(u[0], w[1]), Mul(u[1], w[0])) };
-    const double area2 =
-      sqrt(Add(Add(Mul(normal[0], normal[0]), Mul(normal[1], normal[1])), Mul(normal[2], normal[2])));
-    if (area2 == 0.0)
+    double distance = 0.0;
+    if (!FacePlaneDistance(f, x, distance))
       continue;
-    sum = Add(sum, Div(fabs(Add(Add(Mul(normal[0], d[0]), Mul(normal[1], d[1])), Mul(normal[2], d[2]))), area2));
+    sum = Add(sum, distance);
     ++n;
   }
   return n ? Div(sum, static_cast<double>(n)) : 0.0;
