@@ -393,6 +393,69 @@ TEST(EvaluationBackendSelection, NamesAndDeviceAbsence)
   }
 }
 
+TEST(CudaEvaluationBackend, CandidatesLeftFoldedThatNeedNoValuesAreNotSampled)
+{
+  MOREA_REQUIRE_CUDA_DEVICE();
+  OptimiserTestProblem problem;
+  const auto           population = problem.InitialPopulation(problem.Options());
+  const std::vector<DualMesh> parents(population.begin(), population.begin() + 8);
+  const auto &                group = problem.parallel.groups[0];
+  FoldHandling                handling;
+  handling.constraint = problem.constraint.get();
+  handling.base = &problem.base;
+  handling.repair = true;
+  for (auto interpolation : { CudaInterpolation::Exact, CudaInterpolation::Texture })
+  {
+    const std::string what = interpolation == CudaInterpolation::Exact ? "exact" : "texture";
+    // Steps of about a cell's half width: some candidates stay folded.
+    morea_test::RandomCandidates all(problem, parents, group, 4.0, 41);
+    morea_test::RandomCandidates some(problem, parents, group, 4.0, 41);
+    TetrahedronValues            untouched;
+    untouched.samples = -1.0;
+    for (std::size_t i = 0; i < some.candidates.size(); ++i)
+    {
+      some.candidates[i].evaluateFolded = false;
+      std::fill(some.values[i].begin(), some.values[i].end(), untouched);
+    }
+    auto everything = CreateCudaEvaluationBackend(*problem.evaluator, 2, interpolation);
+    auto skipping = CreateCudaEvaluationBackend(*problem.evaluator, 2, interpolation);
+    everything->SetFoldHandling(handling);
+    skipping->SetFoldHandling(handling);
+    everything->EvaluatePartials(all.candidates);
+    skipping->EvaluatePartials(some.candidates);
+
+    std::size_t leftFolded = 0, evaluated = 0;
+    double      samples = 0.0;
+    for (std::size_t i = 0; i < all.candidates.size(); ++i)
+    {
+      ASSERT_EQ(all.folds[i].foldedSides, some.folds[i].foldedSides) << what << " candidate " << i;
+      ASSERT_EQ(all.folds[i].repairedSides, some.folds[i].repairedSides) << what << " candidate " << i;
+      if (all.folds[i].Folded())
+      {
+        ++leftFolded;
+        for (const TetrahedronValues & v : some.values[i])
+          EXPECT_EQ(v.samples, -1.0) << what << ": values of candidate " << i << " left alone, as on the CPU";
+        continue;
+      }
+      evaluated += all.values[i].size();
+      // Skipping others changes neither the samples nor the sums' order.
+      for (std::size_t k = 0; k < all.values[i].size(); ++k)
+      {
+        samples += all.values[i][k].samples;
+        EXPECT_EQ(all.values[i][k].samples, some.values[i][k].samples) << what << " candidate " << i;
+        EXPECT_EQ(all.values[i][k].intensity, some.values[i][k].intensity) << what << " candidate " << i;
+        EXPECT_EQ(all.values[i][k].guidance, some.values[i][k].guidance) << what << " candidate " << i;
+        EXPECT_EQ(all.values[i][k].magnitude, some.values[i][k].magnitude) << what << " candidate " << i;
+      }
+    }
+    EXPECT_GT(leftFolded, 0u) << what;
+    EXPECT_LT(leftFolded, all.candidates.size()) << what;
+    EXPECT_EQ(skipping->Statistics().samples, samples) << what;
+    EXPECT_EQ(skipping->Statistics().tetrahedra, evaluated) << what;
+    EXPECT_LT(skipping->Statistics().samples, everything->Statistics().samples) << what;
+  }
+}
+
 TEST(CudaEvaluationBackend, FoldChecksAndRepairAgreeWithTheCpu)
 {
   MOREA_REQUIRE_CUDA_DEVICE();

@@ -5,6 +5,7 @@
 #include "TetrahedronKernels.h"
 
 #include "DeviceMemory.h"
+#include "FoldRepairKernels.h"
 
 #include <cstdint>
 
@@ -15,7 +16,8 @@ namespace
 constexpr int GatherThreads = 256;
 
 __global__ void
-GatherCandidateCorners(CandidateBatch b, std::size_t items, double * corners, std::uint32_t * tetrahedra)
+GatherCandidateCorners(CandidateBatch b, std::size_t items, FoldedCandidateSkip skip, double * corners,
+                       std::uint32_t * tetrahedra, std::uint8_t * itemSkip)
 {
   const std::size_t item = static_cast<std::size_t>(blockIdx.x) * blockDim.x + threadIdx.x;
   if (item >= items)
@@ -58,18 +60,25 @@ GatherCandidateCorners(CandidateBatch b, std::size_t items, double * corners, st
     }
   }
   tetrahedra[item] = t;
+  const auto leftFolded = [&skip, c](int side) {
+    const std::uint8_t o = skip.outcome[2 * c + side];
+    return (o & SideFolded) != 0 && (o & SideRepaired) == 0;
+  };
+  itemSkip[item] = skip.skipIfFolded && skip.skipIfFolded[c] && (leftFolded(0) || leftFolded(1)) ? 1 : 0;
 }
 } // namespace
 
 void
-LaunchGatherCandidateCorners(const CandidateBatch & batch, std::size_t items, double * corners,
-                             std::uint32_t * tetrahedra, void * stream)
+LaunchGatherCandidateCorners(const CandidateBatch & batch, std::size_t items, const FoldedCandidateSkip & skip,
+                             double * corners, std::uint32_t * tetrahedra, std::uint8_t * itemSkip, void * stream)
 {
   if (items == 0)
     return;
+  if ((skip.skipIfFolded == nullptr) != (skip.outcome == nullptr))
+    throw Error("CUDA backend: skipping folded candidates needs both their flags and the fold checks' outcome");
   const unsigned blocks = static_cast<unsigned>((items + GatherThreads - 1) / GatherThreads);
-  GatherCandidateCorners<<<blocks, GatherThreads, 0, static_cast<cudaStream_t>(stream)>>>(batch, items, corners,
-                                                                                          tetrahedra);
+  GatherCandidateCorners<<<blocks, GatherThreads, 0, static_cast<cudaStream_t>(stream)>>>(
+    batch, items, skip, corners, tetrahedra, itemSkip);
   Check(cudaGetLastError(), "launching the corner gathering kernel");
 }
 } // namespace morea::cuda

@@ -184,7 +184,17 @@ public:
     if (items > 0)
     {
       Reserve(items);
-      cuda::LaunchGatherCandidateCorners(m_Batch, items, m_Corners.Data(), m_Tetrahedra.Data(), m_Stream->Get());
+      m_ItemSkip.Reserve(items);
+      // Candidates left folded that need no values are not sampled (as on
+      // the CPU): late in a run, about a third of a batch's tetrahedra.
+      cuda::FoldedCandidateSkip skip;
+      if (checks)
+      {
+        skip.skipIfFolded = m_SkipIfFolded;
+        skip.outcome = m_Outcome.Data();
+      }
+      cuda::LaunchGatherCandidateCorners(m_Batch, items, skip, m_Corners.Data(), m_Tetrahedra.Data(),
+                                         m_ItemSkip.Data(), m_Stream->Get());
     }
     // Each candidate's first item, as staged by UploadCandidates.
     const std::uint64_t * first = m_HostFirstItem.Data();
@@ -205,8 +215,9 @@ public:
     itemBounds.push_back(items);
     m_Statistics.stagingSeconds += SecondsSince(start);
 
-    bool foldsRead = false;
-    RunParts(itemBounds, [&](std::size_t p) {
+    bool          foldsRead = false;
+    std::uint64_t skippedItems = 0;
+    RunParts(itemBounds, m_ItemSkip.Data(), [&](std::size_t p) {
       const auto unpack = std::chrono::steady_clock::now();
       if (!foldsRead)
       {
@@ -218,16 +229,28 @@ public:
               *c.folds = CandidateFolds{}; // no dependent tetrahedra, nothing checked
         foldsRead = true;
       }
-      UnpackRange(first, candidateBounds[p], candidateBounds[p + 1],
-                  [&](std::size_t i) { return candidates[i].values; });
+      for (std::size_t i = candidateBounds[p]; i < candidateBounds[p + 1]; ++i)
+        if (Skipped(candidates[i]))
+          skippedItems += first[i + 1] - first[i];
+      UnpackRange(first, candidateBounds[p], candidateBounds[p + 1], [&](std::size_t i) -> TetrahedronValues * {
+        return Skipped(candidates[i]) ? nullptr : candidates[i].values; // left alone, as on the CPU
+      });
       m_Statistics.unpackSeconds += SecondsSince(unpack);
       if (ready)
         ready(candidateBounds[p], candidateBounds[p + 1]);
     });
+    m_Statistics.tetrahedra -= skippedItems;
     m_Statistics.seconds += SecondsSince(start);
   }
 
 private:
+  /** Left folded by the checks and needing no values: not sampled. */
+  static bool
+  Skipped(const PartialCandidate & c)
+  {
+    return c.folds && c.folds->Folded() && !c.evaluateFolded;
+  }
+
   template <typename T>
   const T *
   Upload(const std::vector<T> & host, cuda::DeviceArray<T> & device)
@@ -419,14 +442,17 @@ private:
     if (!any)
       return false;
     m_HostFoldCheck.Reserve(n);
+    m_HostSkipIfFolded.Reserve(n);
     m_HostSideSeeds.Reserve(2 * n);
     m_Pool.ParallelFor(n, [&](std::size_t i) {
       const PartialCandidate & c = candidates[i];
       m_HostFoldCheck[i] = c.folds ? 1 : 0;
+      m_HostSkipIfFolded[i] = c.folds && !c.evaluateFolded ? 1 : 0;
       m_HostSideSeeds[2 * i] = c.folds ? RepairSeed(c.seed, 0) : 0;
       m_HostSideSeeds[2 * i + 1] = c.folds ? RepairSeed(c.seed, 1) : 0;
     });
     m_FoldCheck = UploadAsync(m_HostFoldCheck.Data(), n, m_FoldCheckDevice);
+    m_SkipIfFolded = UploadAsync(m_HostSkipIfFolded.Data(), n, m_SkipIfFoldedDevice);
     m_SideSeeds = UploadAsync(m_HostSideSeeds.Data(), 2 * n, m_SideSeedsDevice);
     return true;
   }
@@ -585,15 +611,17 @@ private:
   void
   Run(std::size_t items)
   {
-    RunParts({ 0, items }, [](std::size_t) {});
+    RunParts({ 0, items }, nullptr, [](std::size_t) {});
   }
 
   /** Evaluates items [bounds[p], bounds[p + 1]) part after part and calls
    *  done(p), in order, once part p's values are on the host. On the texture
    *  path that is while the device samples part p + 1 (each part's first step
-   *  is waited for anyway, to learn its number of chunks). */
+   *  is waited for anyway, to learn its number of chunks). Items whose
+   *  `itemSkip` byte is set (null: none) are not sampled. */
   void
-  RunParts(const std::vector<std::size_t> & bounds, const std::function<void(std::size_t)> & done)
+  RunParts(const std::vector<std::size_t> & bounds, const std::uint8_t * itemSkip,
+           const std::function<void(std::size_t)> & done)
   {
     const std::size_t parts = bounds.size() - 1;
     const std::size_t items = bounds.back();
@@ -618,7 +646,8 @@ private:
       {
         // Step 1 tells how many chunks step 2 has: one synchronisation,
         // after which the earlier parts are done too.
-        cuda::LaunchPrepareTexture(m_Constants, corners, m_Tetrahedra.Data() + begin, count, m_Workspace.Data(),
+        cuda::LaunchPrepareTexture(m_Constants, corners, m_Tetrahedra.Data() + begin,
+                                   itemSkip ? itemSkip + begin : nullptr, count, m_Workspace.Data(),
                                    itemValues, m_HostChunks.Data(), stream);
         Synchronize("preparing the texture sampling");
         const std::size_t chunks = m_HostChunks[0];
@@ -627,7 +656,8 @@ private:
                                   directionValues, stream);
       }
       else
-        cuda::LaunchEvaluateTetrahedra(m_Constants, corners, m_Tetrahedra.Data() + begin, count, itemValues,
+        cuda::LaunchEvaluateTetrahedra(m_Constants, corners, m_Tetrahedra.Data() + begin,
+                                       itemSkip ? itemSkip + begin : nullptr, count, itemValues,
                                        directionValues, stream);
       Check(cudaEventRecord(m_PartEvents[2 * p + 1]->Get(), stream), "recording an event");
       Check(cudaMemcpyAsync(m_HostItemValues.Data() + begin * cuda::ItemValues, itemValues,
@@ -663,7 +693,8 @@ private:
     UnpackRange(first.data(), 0, first.size() - 1, out);
   }
 
-  /** UnpackAll for groups [begin, end) only. */
+  /** UnpackAll for groups [begin, end) only; a group whose out(i) is null
+   *  is left alone. */
   template <typename Output>
   void
   UnpackRange(const std::uint64_t * first, std::size_t begin, std::size_t end, Output out)
@@ -672,6 +703,8 @@ private:
     m_Pool.ParallelFor(end - begin, [&](std::size_t g) {
       const std::size_t   i = begin + g;
       TetrahedronValues * o = out(i);
+      if (o == nullptr)
+        return;
       for (std::size_t item = first[i]; item < first[i + 1]; ++item)
       {
         *o = Unpack(item);
@@ -715,10 +748,12 @@ private:
   cuda::DeviceArray<std::uint32_t> m_PointTetrahedronOffsets, m_PointTetrahedra;
   cuda::DeviceArray<std::int8_t>   m_Pins;
   const std::uint8_t *             m_FoldCheck{ nullptr };
+  const std::uint8_t *             m_SkipIfFolded{ nullptr }; ///< per candidate: left folded, it needs no values
   const std::uint64_t *            m_SideSeeds{ nullptr };
-  cuda::DeviceArray<std::uint8_t>  m_FoldCheckDevice, m_Outcome;
+  cuda::DeviceArray<std::uint8_t>  m_FoldCheckDevice, m_SkipIfFoldedDevice, m_Outcome;
+  cuda::DeviceArray<std::uint8_t>  m_ItemSkip; ///< per item of a batch: not sampled
   cuda::DeviceArray<std::uint64_t> m_SideSeedsDevice;
-  cuda::PinnedArray<std::uint8_t>  m_HostFoldCheck, m_HostOutcome;
+  cuda::PinnedArray<std::uint8_t>  m_HostFoldCheck, m_HostSkipIfFolded, m_HostOutcome;
   cuda::PinnedArray<std::uint64_t> m_HostSideSeeds;
 };
 } // namespace

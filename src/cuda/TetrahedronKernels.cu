@@ -144,8 +144,8 @@ struct PackedExact
 template <typename Sampler, typename View>
 __global__ void __launch_bounds__(256, 2)
 EvaluateTetrahedraKernel(EvaluationConstants k, View moving, View fixed, const double * __restrict__ corners,
-                         const std::uint32_t * __restrict__ tetrahedra, std::size_t items, double * itemOut,
-                         double * directionOut)
+                         const std::uint32_t * __restrict__ tetrahedra, const std::uint8_t * __restrict__ itemSkip,
+                         std::size_t items, double * itemOut, double * directionOut)
 {
   const std::size_t warp = (static_cast<std::size_t>(blockIdx.x) * blockDim.x + threadIdx.x) / 32;
   const int         lane = threadIdx.x & 31;
@@ -171,7 +171,8 @@ EvaluateTetrahedraKernel(EvaluationConstants k, View moving, View fixed, const d
 
   const double volume = fabs(SignedVolume(from));
   double       count = round(__ddiv_rn(__dmul_rn(k.samplingRate, volume), k.voxelVolume));
-  const std::uint32_t n = count < 1.0 ? 1u : static_cast<std::uint32_t>(count);
+  const bool          skipped = itemSkip != nullptr && itemSkip[item] != 0; // no samples: the values go unused
+  const std::uint32_t n = skipped ? 0u : (count < 1.0 ? 1u : static_cast<std::uint32_t>(count));
   std::uint32_t       shift[4];
   SobolShifts(TetrahedronSeed(from), shift);
 
@@ -259,8 +260,8 @@ UploadSobolDirections(const std::uint32_t * directions)
 
 void
 LaunchEvaluateTetrahedra(const EvaluationConstants & constants, const double * corners,
-                         const std::uint32_t * tetrahedra, std::size_t items, double * itemOut,
-                         double * directionOut, void * stream)
+                         const std::uint32_t * tetrahedra, const std::uint8_t * itemSkip, std::size_t items,
+                         double * itemOut, double * directionOut, void * stream)
 {
   if (items == 0)
     return;
@@ -271,10 +272,10 @@ LaunchEvaluateTetrahedra(const EvaluationConstants & constants, const double * c
   const auto &       k = constants;
   if (!k.packed)
     EvaluateTetrahedraKernel<Trilinear><<<grid, WarpsPerBlock * 32, 0, s>>>(k, k.moving, k.fixed, corners, tetrahedra,
-                                                                           items, itemOut, directionOut);
+                                                                           itemSkip, items, itemOut, directionOut);
   else
     EvaluateTetrahedraKernel<PackedExact><<<grid, WarpsPerBlock * 32, 0, s>>>(
-      k, k.packedMoving, k.packedFixed, corners, tetrahedra, items, itemOut, directionOut);
+      k, k.packedMoving, k.packedFixed, corners, tetrahedra, itemSkip, items, itemOut, directionOut);
   Check(cudaGetLastError(), "launching the tetrahedron kernel");
 }
 } // namespace morea::cuda

@@ -98,23 +98,36 @@ constexpr int ItemCorners = 24;
 void
 UploadSobolDirections(const std::uint32_t * directions);
 
+/** Which candidates need no values: those left folded by the fold checks
+ *  (`outcome`, per candidate and side, SideFolded | SideRepaired) whose
+ *  `skipIfFolded` byte is set, as the CPU backend skips them. Both null:
+ *  every candidate is evaluated. */
+struct FoldedCandidateSkip
+{
+  const std::uint8_t * skipIfFolded{ nullptr }; ///< per candidate
+  const std::uint8_t * outcome{ nullptr };      ///< per candidate and side
+};
+
 /** Writes the corners (items x ItemCorners) and tetrahedron index of every
  *  dependent tetrahedron of every candidate of `batch`, in candidate order:
  *  the parents' points with each element's points replaced, as
- *  CandidateCorners does on the host. Asynchronous on `stream`. */
+ *  CandidateCorners does on the host; `itemSkip` (items bytes) is 1 for the
+ *  items of a candidate that `skip` leaves out, else 0. Asynchronous on
+ *  `stream`. */
 void
-LaunchGatherCandidateCorners(const CandidateBatch & batch, std::size_t items, double * corners,
-                             std::uint32_t * tetrahedra, void * stream);
+LaunchGatherCandidateCorners(const CandidateBatch & batch, std::size_t items, const FoldedCandidateSkip & skip,
+                             double * corners, std::uint32_t * tetrahedra, std::uint8_t * itemSkip, void * stream);
 
 /** Evaluates `items` tetrahedra with the exact (software) interpolation:
  *  `corners` (items x 24 doubles) and `tetrahedra` (items indices) on the
  *  device; writes `itemOut` (items x ItemValues) and `directionOut`
- *  (items x 2 x DirectionValues). Asynchronous on `stream` (a cudaStream_t);
- *  checks the launch. */
+ *  (items x 2 x DirectionValues). An item whose `itemSkip` byte is set (null:
+ *  none) is not sampled: its direction values are 0, samples included.
+ *  Asynchronous on `stream` (a cudaStream_t); checks the launch. */
 void
 LaunchEvaluateTetrahedra(const EvaluationConstants & constants, const double * corners,
-                         const std::uint32_t * tetrahedra, std::size_t items, double * itemOut,
-                         double * directionOut, void * stream);
+                         const std::uint32_t * tetrahedra, const std::uint8_t * itemSkip, std::size_t items,
+                         double * itemOut, double * directionOut, void * stream);
 
 /** The texture path (packed images, Interpolation::Texture), built for
  *  throughput in two steps around one synchronisation. Step 1, one thread
@@ -133,9 +146,11 @@ TexturePrepareWorkspaceBytes(std::size_t items);
 std::size_t
 TextureChunkWorkspaceBytes(std::size_t chunks);
 
+/** Step 1; an item whose `itemSkip` byte is set (null: none) gets no
+ *  chunks, and step 2 gives it 0 samples. */
 void
 LaunchPrepareTexture(const EvaluationConstants & constants, const double * corners, const std::uint32_t * tetrahedra,
-                     std::size_t items, void * workspace, double * itemOut, std::uint32_t * totalChunks,
+                     const std::uint8_t * itemSkip, std::size_t items, void * workspace, double * itemOut, std::uint32_t * totalChunks,
                      void * stream);
 
 void

@@ -199,8 +199,9 @@ PrepareDirection(const EvaluationConstants & k, const double from[12], const dou
 
 __global__ void
 PrepareTextureTasks(EvaluationConstants k, const double * __restrict__ corners,
-                    const std::uint32_t * __restrict__ tetrahedra, std::size_t items, SampleTask * tasks,
-                    std::uint32_t * chunkCounts, std::uint32_t * itemIndex, double * itemOut)
+                    const std::uint32_t * __restrict__ tetrahedra, const std::uint8_t * __restrict__ itemSkip,
+                    std::size_t items, SampleTask * tasks, std::uint32_t * chunkCounts, std::uint32_t * itemIndex,
+                    double * itemOut)
 {
   const std::size_t item = static_cast<std::size_t>(blockIdx.x) * blockDim.x + threadIdx.x;
   if (item >= items)
@@ -213,11 +214,15 @@ PrepareTextureTasks(EvaluationConstants k, const double * __restrict__ corners,
     source[i] = c[i];
     target[i] = c[12 + i];
   }
+  // A skipped item (its values go unused) gets no samples, hence no chunks.
+  const bool skipped = itemSkip != nullptr && itemSkip[item] != 0;
   SampleTask task;
   PrepareDirection(k, source, target, k.packedMoving, k.packedFixed, task);
+  task.samples = skipped ? 0u : task.samples;
   tasks[2 * item] = task;
   chunkCounts[2 * item] = (task.samples + k.chunkSamples - 1) / k.chunkSamples;
   PrepareDirection(k, target, source, k.packedFixed, k.packedMoving, task);
+  task.samples = skipped ? 0u : task.samples;
   tasks[2 * item + 1] = task;
   chunkCounts[2 * item + 1] = (task.samples + k.chunkSamples - 1) / k.chunkSamples;
 
@@ -496,7 +501,7 @@ TextureChunkWorkspaceBytes(std::size_t chunks)
 
 void
 LaunchPrepareTexture(const EvaluationConstants & constants, const double * corners, const std::uint32_t * tetrahedra,
-                     std::size_t items, void * workspace, double * itemOut, std::uint32_t * totalChunks,
+                     const std::uint8_t * itemSkip, std::size_t items, void * workspace, double * itemOut, std::uint32_t * totalChunks,
                      void * stream)
 {
   if (items == 0)
@@ -506,7 +511,7 @@ LaunchPrepareTexture(const EvaluationConstants & constants, const double * corne
   const cudaStream_t     s = static_cast<cudaStream_t>(stream);
   const PrepareWorkspace w = Partition(workspace, items);
   const unsigned         blocks = static_cast<unsigned>((items + PrepareThreads - 1) / PrepareThreads);
-  PrepareTextureTasks<<<blocks, PrepareThreads, 0, s>>>(constants, corners, tetrahedra, items, w.tasks,
+  PrepareTextureTasks<<<blocks, PrepareThreads, 0, s>>>(constants, corners, tetrahedra, itemSkip, items, w.tasks,
                                                         w.chunkCounts, w.itemIndex, itemOut);
   Check(cudaGetLastError(), "launching the texture set-up kernel");
   std::size_t bytes = w.scratchBytes;
