@@ -37,11 +37,21 @@ struct PackedVolumeView
   unsigned long long intensityTexture{ 0 };      ///< Texture: cudaTextureObject_t
   unsigned long long distanceTexture{ 0 };       ///< Texture: cudaTextureObject_t (0: no structures)
   int                distanceChannels{ 0 };      ///< Texture: 1, 2 or 4
+  /** Texture: per block of NearBlockSize^3 texels (x fastest), 1 where a
+   *  sample whose trilinear footprint starts in the block may lie within
+   *  the guidance radius of a contour: the smallest distance of the texels
+   *  it can read is below the radius (an interpolated value is never below
+   *  its texels' minimum). Null without structures. */
+  const std::uint8_t * nearBlocks{ nullptr };
+  int                  blocks[3]{ 0, 0, 0 };
   int                size[3]{ 0, 0, 0 };
   double             origin[3]{ 0.0, 0.0, 0.0 };
   double             spacing[3]{ 1.0, 1.0, 1.0 };
   double             inverseSpacing[3]{ 1.0, 1.0, 1.0 };
 };
+
+/** Edge of PackedVolumeView::nearBlocks' blocks, in texels. */
+constexpr int NearBlockSize = 4;
 
 /** Everything a tetrahedron's evaluation reads besides its corners. */
 struct EvaluationConstants
