@@ -420,13 +420,13 @@ private:
       const PartialCandidate & c = candidates[i];
       if (c.parent != lastParent)
       {
-        const auto p = parentSlot.emplace(c.parent, static_cast<std::uint32_t>(parents.size()));
+        const auto p = parentSlot.try_emplace(c.parent, static_cast<std::uint32_t>(parents.size()));
         if (p.second)
           parents.push_back(c.parent);
         lastParent = c.parent;
         lastSlot = p.first->second;
       }
-      const auto e = elementSlot.emplace(c.element, static_cast<std::uint32_t>(pointOffsets.size() - 1));
+      const auto e = elementSlot.try_emplace(c.element, static_cast<std::uint32_t>(pointOffsets.size() - 1));
       if (e.second)
       {
         points.insert(points.end(), c.element->points.begin(), c.element->points.end());
