@@ -12,6 +12,7 @@
 #include "TetrahedronKernels.h"
 
 #include "morea/ComputeDevices.h"
+#include "morea/NearContourBlocks.h"
 #include "morea/Error.h"
 #include "morea/TetrahedronSampling.h"
 #include "morea/ThreadPool.h"
@@ -20,7 +21,6 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
-#include <limits>
 #include <unordered_map>
 #include <vector>
 
@@ -49,49 +49,7 @@ struct VolumeTextures
   cuda::DeviceArray<std::uint8_t>  nearBlocks; ///< see cuda::PackedVolumeView::nearBlocks
 };
 
-/** cuda::PackedVolumeView::nearBlocks of `volume` (channel 0 the intensity,
- *  then one distance per structure); `blocks` gets their counts per axis. A
- *  block is marked when any texel a sample starting in it reads, [4 b, 4 b + 4]
- *  per axis, has a distance below the radius, plus a margin for the texture
- *  filter's rounding. */
-std::vector<std::uint8_t>
-NearContourBlocks(const ChannelVolume & volume, double radius, int blocks[3])
-{
-  constexpr std::size_t B = cuda::NearBlockSize;
-  std::size_t           n[3];
-  for (int a = 0; a < 3; ++a)
-  {
-    n[a] = (volume.size[a] + B - 1) / B;
-    blocks[a] = static_cast<int>(n[a]);
-  }
-  std::vector<std::uint8_t> mask(n[0] * n[1] * n[2], 0);
-  const double limit = radius * (1.0 + 1e-5) + 1e-6;
-  std::size_t  v = 0;
-  for (std::size_t z = 0; z < volume.size[2]; ++z)
-    for (std::size_t y = 0; y < volume.size[1]; ++y)
-      for (std::size_t x = 0; x < volume.size[0]; ++x, ++v)
-      {
-        float nearest = std::numeric_limits<float>::infinity();
-        for (std::size_t g = 1; g < volume.channels; ++g)
-          nearest = std::min(nearest, volume.data[volume.channels * v + g]);
-        if (!(nearest < limit))
-          continue;
-        // Texel i lies in the ranges of block i / B and, on a block's first
-        // texel, of the block before.
-        const std::size_t at[3] = { x, y, z };
-        std::size_t       from[3], to[3];
-        for (int a = 0; a < 3; ++a)
-        {
-          to[a] = at[a] / B;
-          from[a] = at[a] % B == 0 && at[a] > 0 ? to[a] - 1 : to[a];
-        }
-        for (std::size_t bz = from[2]; bz <= to[2]; ++bz)
-          for (std::size_t by = from[1]; by <= to[1]; ++by)
-            for (std::size_t bx = from[0]; bx <= to[0]; ++bx)
-              mask[(bz * n[1] + by) * n[0] + bx] = 1;
-      }
-  return mask;
-}
+static_assert(NearContourBlocks::BlockSize == cuda::NearBlockSize, "the sampling kernel's blocks are the core's");
 
 class CudaEvaluationBackend final : public EvaluationBackend
 {
@@ -374,11 +332,13 @@ private:
           std::make_unique<cuda::Texture3D>(distance.data(), channels * sizeof(float), format, view.size);
         view.distanceTexture = static_cast<unsigned long long>(textures.distance->Get());
         view.distanceChannels = channels;
-        const std::vector<std::uint8_t> mask = NearContourBlocks(volume, m_Constants.guidanceRadius, view.blocks);
-        textures.nearBlocks.Reserve(mask.size());
-        Check(cudaMemcpy(textures.nearBlocks.Data(), mask.data(), mask.size(), cudaMemcpyHostToDevice),
+        const NearContourBlocks near = FindNearContourBlocks(volume, m_Constants.guidanceRadius);
+        textures.nearBlocks.Reserve(near.mask.size());
+        Check(cudaMemcpy(textures.nearBlocks.Data(), near.mask.data(), near.mask.size(), cudaMemcpyHostToDevice),
               "uploading the near-contour blocks");
         view.nearBlocks = textures.nearBlocks.Data();
+        for (int a = 0; a < 3; ++a)
+          view.blocks[a] = near.blocks[a];
       }
       return view;
     }

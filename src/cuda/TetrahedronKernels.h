@@ -50,7 +50,8 @@ struct PackedVolumeView
   double             inverseSpacing[3]{ 1.0, 1.0, 1.0 };
 };
 
-/** Edge of PackedVolumeView::nearBlocks' blocks, in texels. */
+/** Edge of PackedVolumeView::nearBlocks' blocks, in texels
+ *  (morea::NearContourBlocks::BlockSize). */
 constexpr int NearBlockSize = 4;
 
 /** Everything a tetrahedron's evaluation reads besides its corners. */

@@ -293,7 +293,8 @@ ScatterChunkTasks(const std::uint32_t * __restrict__ sortedItems, const std::uin
 
 /** Whether the distance at texel position `p` may be below the guidance
  *  radius (PackedVolumeView::nearBlocks). The block of the footprint's
- *  first texel floor(p - 1/2), clamped as the texture clamps. */
+ *  first texel floor(p - 1/2), clamped as the texture clamps: the rule of
+ *  morea::NearContourBlocks::BlockOf, in texel coordinates. */
 __device__ bool
 MayBeNearContour(const std::uint8_t * __restrict__ nearBlocks, const int blocks[3], const float p[3])
 {
