@@ -456,6 +456,73 @@ TEST(CudaEvaluationBackend, CandidatesLeftFoldedThatNeedNoValuesAreNotSampled)
   }
 }
 
+TEST(CudaEvaluationBackend, ParentsWithKeysAreKeptOnTheDevice)
+{
+  MOREA_REQUIRE_CUDA_DEVICE();
+  OptimiserTestProblem  problem;
+  const auto            population = problem.InitialPopulation(problem.Options());
+  std::vector<DualMesh> parents(population.begin(), population.begin() + 4);
+  morea_test::RandomCandidates batch(problem, parents, problem.parallel.groups[0], 1.0, 5);
+  const auto withKeys = [&](const std::vector<std::uint64_t> & keys) {
+    for (PartialCandidate & c : batch.candidates)
+      c.parentKey = keys[static_cast<std::size_t>(c.parent - parents.data())];
+    return batch.candidates;
+  };
+  const auto cpuValues = [&] {
+    std::vector<std::vector<Vec3>>              source = batch.source, target = batch.target;
+    std::vector<std::vector<TetrahedronValues>> values = batch.values;
+    std::vector<PartialCandidate>               candidates = batch.candidates;
+    for (std::size_t i = 0; i < candidates.size(); ++i)
+    {
+      candidates[i].source = source[i].data();
+      candidates[i].target = target[i].data();
+      candidates[i].values = values[i].data();
+      candidates[i].folds = nullptr;
+    }
+    CreateCpuEvaluationBackend(*problem.evaluator, 2)->EvaluatePartials(candidates);
+    return values;
+  };
+  auto cuda = CreateCudaEvaluationBackend(*problem.evaluator, 2);
+  cuda->EvaluatePartials(withKeys({ 1, 2, 3, 4 }));
+  EXPECT_EQ(cuda->Statistics().parentsUploaded, 4u);
+  const auto first = batch.values;
+  const auto cpuFirst = cpuValues();
+  for (std::size_t i = 0; i < first.size(); ++i)
+    ExpectSameTotals(cpuFirst[i], first[i], "candidate " + std::to_string(i), 1e-6);
+
+  // The same keys again: nothing is uploaded, the values are the same.
+  cuda->EvaluatePartials(withKeys({ 1, 2, 3, 4 }));
+  EXPECT_EQ(cuda->Statistics().parentsUploaded, 4u);
+  for (std::size_t i = 0; i < first.size(); ++i)
+    for (std::size_t k = 0; k < first[i].size(); ++k)
+      ASSERT_EQ(batch.values[i][k].intensity, first[i][k].intensity) << "candidate " << i;
+
+  // Parent 0 changes. Under its old key the device still uses the points it
+  // holds (the key is a promise the caller keeps)...
+  parents[0] = population[5];
+  const auto cpuChanged = cpuValues();
+  cuda->EvaluatePartials(withKeys({ 1, 2, 3, 4 }));
+  EXPECT_EQ(cuda->Statistics().parentsUploaded, 4u);
+  bool differs = false;
+  for (std::size_t i = 0; i < first.size(); ++i)
+    for (std::size_t k = 0; k < first[i].size(); ++k)
+    {
+      ASSERT_EQ(batch.values[i][k].intensity, first[i][k].intensity) << "candidate " << i;
+      differs = differs || cpuChanged[i][k].intensity != first[i][k].intensity;
+    }
+  ASSERT_TRUE(differs) << "the change of parent 0 does not matter to its candidates";
+  // ... under a new key it is uploaded (it alone) and evaluated as it is now.
+  cuda->EvaluatePartials(withKeys({ 9, 2, 3, 4 }));
+  EXPECT_EQ(cuda->Statistics().parentsUploaded, 5u);
+  for (std::size_t i = 0; i < first.size(); ++i)
+    ExpectSameTotals(cpuChanged[i], batch.values[i], "candidate " + std::to_string(i), 1e-6);
+  // Without keys every parent goes up each time.
+  cuda->EvaluatePartials(withKeys({ 0, 0, 0, 0 }));
+  EXPECT_EQ(cuda->Statistics().parentsUploaded, 9u);
+  for (std::size_t i = 0; i < first.size(); ++i)
+    ExpectSameTotals(cpuChanged[i], batch.values[i], "candidate " + std::to_string(i), 1e-6);
+}
+
 TEST(CudaEvaluationBackend, FoldChecksAndRepairAgreeWithTheCpu)
 {
   MOREA_REQUIRE_CUDA_DEVICE();

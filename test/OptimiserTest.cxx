@@ -21,7 +21,8 @@ using morea_test::OptimiserTestProblem;
 
 namespace
 {
-/** Forwards to the CPU backend with the batch shuffled. */
+/** Forwards to the CPU backend with the batch shuffled, the caller's
+ *  meanwhile work at another time. */
 class ShufflingBackend final : public EvaluationBackend
 {
 public:
@@ -41,11 +42,15 @@ public:
   }
   using EvaluationBackend::EvaluatePartials;
   void
-  EvaluatePartials(const std::vector<PartialCandidate> & candidates, const ReadyCandidates & ready) override
+  EvaluatePartials(const std::vector<PartialCandidate> & candidates, const ReadyCandidates & ready,
+                   const Meanwhile & meanwhile) override
   {
     std::vector<PartialCandidate> shuffled = candidates;
     std::shuffle(shuffled.begin(), shuffled.end(), m_Random);
     m_Cpu->EvaluatePartials(shuffled);
+    // After the evaluation (the CPU backend calls it before).
+    if (meanwhile)
+      meanwhile();
     // Handed over in parts of random sizes, as a device backend may.
     for (std::size_t begin = 0; ready && begin < candidates.size();)
     {

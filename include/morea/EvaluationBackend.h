@@ -49,6 +49,11 @@ struct PartialCandidate
   /** False: a candidate still folded after its repair gets no values (its
    *  parent is fold-free, so it cannot replace it). */
   bool evaluateFolded{ true };
+  /** Names the parent's points: parents with one nonzero key have equal
+   *  points, in this call and in later ones, so a backend may keep them
+   *  between calls (the CUDA backend keeps them on the device and uploads
+   *  only parents with keys it does not hold). 0: no such promise. */
+  std::uint64_t parentKey{ 0 };
 };
 
 /** How EvaluatePartials treats folds (SPEC 5). Each side of a candidate with
@@ -78,6 +83,13 @@ struct BackendStatistics
   double stagingSeconds{ 0.0 };
   double waitSeconds{ 0.0 };
   double unpackSeconds{ 0.0 };
+  /** CUDA only: device time from each EvaluatePartials batch's first upload
+   *  to its last kernel's end; the rest of the wall time the device waited
+   *  for the host between batches. */
+  double batchSpanSeconds{ 0.0 };
+  /** CUDA only: parents uploaded by EvaluatePartials (those whose key it
+   *  did not hold, see PartialCandidate::parentKey). */
+  std::uint64_t parentsUploaded{ 0 };
 };
 
 class EvaluationBackend
@@ -105,20 +117,35 @@ public:
    *  values and fold outcomes. */
   using ReadyCandidates = std::function<void(std::size_t begin, std::size_t end)>;
 
+  /** Work of the caller's that needs neither the batch nor its parents. */
+  using Meanwhile = std::function<void()>;
+
   /** The dependent tetrahedra of every candidate, each with its moved points;
    *  fold checks first where asked for (SetFoldHandling). */
   void
   EvaluatePartials(const std::vector<PartialCandidate> & candidates)
   {
-    EvaluatePartials(candidates, ReadyCandidates{});
+    EvaluatePartials(candidates, ReadyCandidates{}, Meanwhile{});
   }
 
   /** As above, calling `ready` (if set) for consecutive ranges that cover all
    *  candidates, in order, before returning. A backend that evaluates in
    *  parts (CUDA) calls it as each part is done, so the caller works on the
    *  first candidates while the device computes the rest. */
+  void
+  EvaluatePartials(const std::vector<PartialCandidate> & candidates, const ReadyCandidates & ready)
+  {
+    EvaluatePartials(candidates, ready, Meanwhile{});
+  }
+
+  /** As above, calling `meanwhile` (if set) once, on the calling thread,
+   *  before the first `ready`: the CUDA backend calls it once the device
+   *  has work queued, so the caller prepares its next batch while the device
+   *  computes this one. It must not touch the candidates, their points or
+   *  their parents. */
   virtual void
-  EvaluatePartials(const std::vector<PartialCandidate> & candidates, const ReadyCandidates & ready) = 0;
+  EvaluatePartials(const std::vector<PartialCandidate> & candidates, const ReadyCandidates & ready,
+                   const Meanwhile & meanwhile) = 0;
 
   /** Fold checks and repair of later EvaluatePartials calls; the constraint
    *  and base mesh must outlive them. */

@@ -203,7 +203,8 @@ private:
   /** Repairs (when enabled) and evaluates `candidates`, then accepts them in
    *  order; returns how many were accepted. */
   std::size_t
-  ProcessCandidates(CandidateBatch & batch, GenerationRecord & record);
+  ProcessCandidates(CandidateBatch & batch, GenerationRecord & record,
+                    const EvaluationBackend::Meanwhile & meanwhile = {});
   /** The acceptance step of ProcessCandidates for candidates [begin, end),
    *  which have their values; `changed` marks solutions changed since their
    *  verdicts were taken. */
@@ -215,6 +216,9 @@ private:
   ForcedImprovement(std::size_t solution, int singleObjective, RandomGenerator & random, GenerationRecord & record);
   bool
   InsertIntoArchive(std::size_t solution, const Fitness & fitness);
+  /** A fresh m_KeySalt (the ids start again). */
+  void
+  RenewKeySalt();
   /** `counters` (accepted, repaired, ..., seconds) completed with the archive's state. */
   GenerationRecord
   Summarise(std::size_t generation, GenerationRecord counters) const;
@@ -227,6 +231,7 @@ private:
   GomeaOptions              m_Options;
   std::unique_ptr<ThreadPool> m_Pool; ///< candidate sampling and fold checks
   std::unique_ptr<CandidateBatch> m_Batch; ///< reused by every batch
+  std::unique_ptr<CandidateBatch> m_NextBatch; ///< sampled while m_Batch is evaluated
 
   std::size_t                             m_Generation{ 0 };
   std::vector<DualMesh>                   m_Population;
@@ -235,6 +240,10 @@ private:
   std::vector<std::vector<TetrahedronValues>> m_TetValues;
   std::vector<std::size_t>                m_NoImprovement; ///< per solution, generations without an accepted change
   std::uint64_t                           m_NextId{ 0 };
+  /** Mixed with a solution's id into PartialCandidate::parentKey: unique to
+   *  this optimiser's population since its last Initialize or checkpoint
+   *  load, so that another population sharing the backend never matches. */
+  std::uint64_t                           m_KeySalt{ 0 };
   std::unique_ptr<ElitistArchive>         m_Archive;
   ObjectiveVector                         m_Reference{ { 1.0, 1.0, 1.0 } }; ///< hypervolume reference
   std::vector<std::vector<DistributionState>> m_Distributions;   ///< per cluster (k + objectives), per element

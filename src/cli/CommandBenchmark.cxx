@@ -80,6 +80,8 @@ TimeBackend(const std::string & name, const itk::morea::MeshModel & model, const
                               { "tetrahedra", after.tetrahedra - before.tetrahedra },
                               { "samples", after.samples - before.samples },
                               { "batches", after.batches - before.batches },
+                              { "parents_uploaded", after.parentsUploaded - before.parentsUploaded },
+                              { "batch_span_seconds", after.batchSpanSeconds - before.batchSpanSeconds },
                               { "best_guidance", r.bestGuidance },
                               { "hypervolume", r.hypervolume },
                               { "archive", r.archiveSize },
@@ -99,7 +101,9 @@ TimeBackend(const std::string & name, const itk::morea::MeshModel & model, const
               << " s (backend " << after.seconds - before.seconds << " s, kernels "
               << after.kernelSeconds - before.kernelSeconds << " s, staging "
               << after.stagingSeconds - before.stagingSeconds << ", waiting " << after.waitSeconds - before.waitSeconds
-              << ", unpacking " << after.unpackSeconds - before.unpackSeconds << "; sampling " << r.phaseSeconds.sampling
+              << ", unpacking " << after.unpackSeconds - before.unpackSeconds << ", parents uploaded "
+              << after.parentsUploaded - before.parentsUploaded << ", batch spans "
+              << after.batchSpanSeconds - before.batchSpanSeconds << "; sampling " << r.phaseSeconds.sampling
               << ", folds " << r.phaseSeconds.foldChecks << ", acceptance " << r.phaseSeconds.acceptance
               << ", forced " << r.phaseSeconds.forcedImprovements << ", modelling " << r.phaseSeconds.modelling
               << ", bookkeeping " << r.phaseSeconds.bookkeeping << "), best guidance " << std::defaultfloat

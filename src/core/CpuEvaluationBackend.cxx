@@ -131,8 +131,11 @@ public:
 
   using EvaluationBackend::EvaluatePartials;
   void
-  EvaluatePartials(const std::vector<PartialCandidate> & candidates, const ReadyCandidates & ready) override
+  EvaluatePartials(const std::vector<PartialCandidate> & candidates, const ReadyCandidates & ready,
+                   const Meanwhile & meanwhile) override
   {
+    if (meanwhile)
+      meanwhile(); // nothing runs beside the caller here
     const auto   start = std::chrono::steady_clock::now();
     const auto & tets = m_Evaluator.Topology().Tetrahedra();
     std::vector<std::uint8_t> skip(candidates.size(), 0);

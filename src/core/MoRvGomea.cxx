@@ -6,6 +6,7 @@
 #include "morea/ThreadPool.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -245,6 +246,7 @@ MoRvGomea::MoRvGomea(const TetrahedralMesh & base, const MeshTopology & topology
   m_Archive = std::make_unique<ElitistArchive>(options.archiveCapacity);
   m_Pool = std::make_unique<ThreadPool>(options.threads);
   m_Batch = std::make_unique<CandidateBatch>();
+  m_NextBatch = std::make_unique<CandidateBatch>();
   FoldHandling folds;
   folds.constraint = &m_Constraint;
   folds.base = &m_Base;
@@ -320,6 +322,14 @@ MoRvGomea::InsertIntoArchive(std::size_t s, const Fitness & fitness)
 }
 
 void
+MoRvGomea::RenewKeySalt()
+{
+  // Distinct in this process: ids of two populations never share a key.
+  static std::atomic<std::uint64_t> populations{ 0 };
+  m_KeySalt = HashCombine(0x70617265ULL, ++populations);
+}
+
+void
 MoRvGomea::Initialize(std::vector<DualMesh> population)
 {
   if (population.size() != m_Options.populationSize)
@@ -337,6 +347,7 @@ MoRvGomea::Initialize(std::vector<DualMesh> population)
   m_Ids.resize(m_Population.size());
   std::iota(m_Ids.begin(), m_Ids.end(), std::uint64_t{ 0 });
   m_NextId = m_Population.size();
+  RenewKeySalt();
   m_Totals.assign(m_Population.size(), ObjectiveTotals{});
   m_TetValues.assign(m_Population.size(), {});
   m_NoImprovement.assign(m_Population.size(), 0);
@@ -682,7 +693,8 @@ MoRvGomea::SampleCandidates(CandidateBatch & batch, const std::vector<ClusterMod
 }
 
 std::size_t
-MoRvGomea::ProcessCandidates(CandidateBatch & candidateBatch, GenerationRecord & record)
+MoRvGomea::ProcessCandidates(CandidateBatch & candidateBatch, GenerationRecord & record,
+                             const EvaluationBackend::Meanwhile & meanwhile)
 {
   std::vector<Candidate> & candidates = candidateBatch.candidates;
   // 1. Fold checks (and repair) and evaluation of the whole batch at once,
@@ -696,6 +708,9 @@ MoRvGomea::ProcessCandidates(CandidateBatch & candidateBatch, GenerationRecord &
     Candidate &        c = candidates[i];
     PartialCandidate & p = batch[i];
     p.parent = &m_Population[c.solution];
+    // An id names one set of points (a change gets a new id, a donor's
+    // points keep the donor's), so the key lets the backend keep parents.
+    p.parentKey = std::max<std::uint64_t>(1, HashCombine(m_KeySalt, m_Ids[c.solution]));
     p.element = &m_Parallel.elements[c.element];
     p.source = candidateBatch.Source(c);
     p.target = candidateBatch.Target(c);
@@ -715,11 +730,18 @@ MoRvGomea::ProcessCandidates(CandidateBatch & candidateBatch, GenerationRecord &
     acceptanceSeconds += SecondsSince(phaseStart);
   };
   const BackendStatistics before = m_Backend.Statistics();
-  const auto              evaluationStart = std::chrono::steady_clock::now();
-  m_Backend.EvaluatePartials(batch, accept);
+  double                  meanwhileSeconds = 0.0;
+  const auto              timedMeanwhile = [&] {
+    const auto phaseStart = std::chrono::steady_clock::now();
+    meanwhile();
+    meanwhileSeconds += SecondsSince(phaseStart);
+  };
+  const auto evaluationStart = std::chrono::steady_clock::now();
+  m_Backend.EvaluatePartials(batch, accept, meanwhile ? EvaluationBackend::Meanwhile(timedMeanwhile) : nullptr);
   const double foldSeconds = m_Backend.Statistics().foldSeconds - before.foldSeconds;
   record.phaseSeconds.foldChecks += foldSeconds;
-  record.phaseSeconds.evaluation += SecondsSince(evaluationStart) - foldSeconds - acceptanceSeconds;
+  record.phaseSeconds.evaluation +=
+    SecondsSince(evaluationStart) - foldSeconds - acceptanceSeconds - meanwhileSeconds;
   record.phaseSeconds.acceptance += acceptanceSeconds;
   record.accepted += accepted;
   return accepted;
@@ -958,10 +980,13 @@ MoRvGomea::RunGeneration()
     }
   }
 
-  CandidateBatch & batch = *m_Batch;
-  for (std::size_t g : groupOrder)
-  {
-    std::vector<Candidate> & candidates = batch.candidates;
+  // Each batch's candidates are drawn while the backend evaluates the one
+  // before (their samples depend on the cluster models only, not on what
+  // that batch accepts); the seeds come in the same order as drawing each
+  // batch just before its evaluation.
+  const auto drawBatch = [&](std::size_t g, CandidateBatch & next) {
+    const auto               sampling = std::chrono::steady_clock::now();
+    std::vector<Candidate> & candidates = next.candidates;
     candidates.clear();
     for (const Member & member : members)
       for (std::uint32_t e : m_Parallel.groups[g])
@@ -975,11 +1000,19 @@ MoRvGomea::RunGeneration()
         cand.anticipate = member.anticipate;
         candidates.push_back(cand);
       }
-    const auto sampling = std::chrono::steady_clock::now();
-    SampleCandidates(batch, clusters);
+    SampleCandidates(next, clusters);
     record.phaseSeconds.sampling += SecondsSince(sampling);
-    ProcessCandidates(batch, record);
-    for (const Candidate & cand : candidates)
+  };
+  if (!groupOrder.empty())
+    drawBatch(groupOrder.front(), *m_Batch);
+  for (std::size_t i = 0; i < groupOrder.size(); ++i)
+  {
+    CandidateBatch & batch = *m_Batch;
+    EvaluationBackend::Meanwhile drawNext;
+    if (i + 1 < groupOrder.size())
+      drawNext = [&, i] { drawBatch(groupOrder[i + 1], *m_NextBatch); };
+    ProcessCandidates(batch, record, drawNext);
+    for (const Candidate & cand : batch.candidates)
       if (cand.accepted)
       {
         improved[cand.solution] = true;
@@ -990,6 +1023,7 @@ MoRvGomea::RunGeneration()
           sum[a] += sample[a];
         ++acceptedCount[cand.cluster][cand.element];
       }
+    std::swap(m_Batch, m_NextBatch);
   }
   const auto bookkeeping = std::chrono::steady_clock::now();
   double     forcedSeconds = 0.0;

@@ -262,6 +262,7 @@ MoRvGomea::Load(std::istream & in)
   m_Reference = reference;
   m_Population = std::move(population);
   m_Ids = std::move(ids);
+  RenewKeySalt();
   m_NoImprovement = std::move(stalls);
   m_TetValues.assign(m_Population.size(), {});
   m_Totals.assign(m_Population.size(), ObjectiveTotals{});

@@ -66,6 +66,15 @@ GatherCandidateCorners(CandidateBatch b, std::size_t items, FoldedCandidateSkip 
   };
   itemSkip[item] = skip.skipIfFolded && skip.skipIfFolded[c] && (leftFolded(0) || leftFolded(1)) ? 1 : 0;
 }
+
+__global__ void
+ScatterParents(const double * __restrict__ staged, const std::uint32_t * __restrict__ slots, std::size_t count,
+               std::size_t perParent, double * store)
+{
+  const std::size_t i = static_cast<std::size_t>(blockIdx.x) * blockDim.x + threadIdx.x;
+  if (i < count * perParent)
+    store[static_cast<std::size_t>(slots[i / perParent]) * perParent + i % perParent] = staged[i];
+}
 } // namespace
 
 void
@@ -80,5 +89,18 @@ LaunchGatherCandidateCorners(const CandidateBatch & batch, std::size_t items, co
   GatherCandidateCorners<<<blocks, GatherThreads, 0, static_cast<cudaStream_t>(stream)>>>(
     batch, items, skip, corners, tetrahedra, itemSkip);
   Check(cudaGetLastError(), "launching the corner gathering kernel");
+}
+
+void
+LaunchScatterParents(const double * staged, const std::uint32_t * slots, std::size_t count, std::size_t perParent,
+                     double * store, void * stream)
+{
+  if (count == 0)
+    return;
+  const std::size_t values = count * perParent;
+  const unsigned    blocks = static_cast<unsigned>((values + GatherThreads - 1) / GatherThreads);
+  ScatterParents<<<blocks, GatherThreads, 0, static_cast<cudaStream_t>(stream)>>>(staged, slots, count, perParent,
+                                                                                  store);
+  Check(cudaGetLastError(), "launching the parent scatter kernel");
 }
 } // namespace morea::cuda

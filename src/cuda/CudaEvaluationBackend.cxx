@@ -13,6 +13,7 @@
 
 #include "morea/ComputeDevices.h"
 #include "morea/NearContourBlocks.h"
+#include "morea/ParentSlots.h"
 #include "morea/Error.h"
 #include "morea/TetrahedronSampling.h"
 #include "morea/ThreadPool.h"
@@ -66,6 +67,8 @@ public:
     m_CopyStream = std::make_unique<cuda::Stream>();
     m_FoldStart = std::make_unique<cuda::Event>();
     m_FoldEnd = std::make_unique<cuda::Event>();
+    m_BatchStart = std::make_unique<cuda::Event>();
+    m_BatchEnd = std::make_unique<cuda::Event>();
     m_HostChunks.Reserve(1);
     cuda::UploadSobolDirections(SobolDirectionNumbers());
 
@@ -182,9 +185,11 @@ public:
 
   using EvaluationBackend::EvaluatePartials;
   void
-  EvaluatePartials(const std::vector<PartialCandidate> & candidates, const ReadyCandidates & ready) override
+  EvaluatePartials(const std::vector<PartialCandidate> & candidates, const ReadyCandidates & ready,
+                   const Meanwhile & meanwhile) override
   {
     const auto  start = std::chrono::steady_clock::now();
+    Check(cudaEventRecord(m_BatchStart->Get(), m_Stream->Get()), "recording an event");
     const auto  items = UploadCandidates(candidates);
     const bool  checks = items > 0 && StageFoldChecks(candidates);
     if (checks)
@@ -228,7 +233,7 @@ public:
 
     bool          foldsRead = false;
     std::uint64_t skippedItems = 0;
-    RunParts(itemBounds, m_ItemSkip.Data(), [&](std::size_t p) {
+    RunParts(itemBounds, m_ItemSkip.Data(), meanwhile, [&](std::size_t p) {
       const auto unpack = std::chrono::steady_clock::now();
       if (!foldsRead)
       {
@@ -251,6 +256,7 @@ public:
         ready(candidateBounds[p], candidateBounds[p + 1]);
     });
     m_Statistics.tetrahedra -= skippedItems;
+    m_Statistics.batchSpanSeconds += ElapsedSeconds(*m_BatchStart, *m_BatchEnd);
     m_Statistics.seconds += SecondsSince(start);
   }
 
@@ -353,8 +359,9 @@ private:
     return view;
   }
 
-  /** Uploads the batch's parents (each once), elements (each once),
-   *  candidate table and moved points; returns the number of items. */
+  /** Uploads the batch's parents (those the device does not hold, see
+   *  PartialCandidate::parentKey), elements (each once), candidate table and
+   *  moved points; returns the number of items. */
   std::size_t
   UploadCandidates(const std::vector<PartialCandidate> & candidates)
   {
@@ -362,9 +369,10 @@ private:
     // candidates one after another, so the parent lookup is mostly the
     // previous one); the bulk (coordinates, parents) in parallel, straight
     // into pinned memory.
-    std::unordered_map<const DualMesh *, std::uint32_t>   parentSlot;
+    std::unordered_map<const DualMesh *, std::uint32_t>   parentIndex;
     std::unordered_map<const FosElement *, std::uint32_t> elementSlot;
     std::vector<const DualMesh *>                         parents;
+    std::vector<std::uint64_t>                            parentKeys;
     std::vector<std::uint32_t> pointOffsets{ 0 }, points, tetrahedronOffsets{ 0 }, dependent;
     const std::size_t          n = candidates.size();
     m_HostCandidateElement.Reserve(std::max<std::size_t>(1, n));
@@ -373,18 +381,23 @@ private:
     m_HostFirstItem.Reserve(n + 1);
     m_HostFirstItem[0] = 0;
     const DualMesh * lastParent = nullptr;
-    std::uint32_t    lastSlot = 0;
+    std::uint32_t    lastIndex = 0;
     std::size_t      movedPoints = 0;
     for (std::size_t i = 0; i < n; ++i)
     {
       const PartialCandidate & c = candidates[i];
       if (c.parent != lastParent)
       {
-        const auto p = parentSlot.try_emplace(c.parent, static_cast<std::uint32_t>(parents.size()));
+        const auto p = parentIndex.try_emplace(c.parent, static_cast<std::uint32_t>(parents.size()));
         if (p.second)
+        {
           parents.push_back(c.parent);
+          parentKeys.push_back(c.parentKey);
+        }
+        else if (parentKeys[p.first->second] != c.parentKey)
+          throw Error("evaluation backend: one parent with two keys in a batch");
         lastParent = c.parent;
-        lastSlot = p.first->second;
+        lastIndex = p.first->second;
       }
       const auto e = elementSlot.try_emplace(c.element, static_cast<std::uint32_t>(pointOffsets.size() - 1));
       if (e.second)
@@ -395,7 +408,7 @@ private:
         tetrahedronOffsets.push_back(static_cast<std::uint32_t>(dependent.size()));
       }
       m_HostCandidateElement[i] = e.first->second;
-      m_HostCandidateParent[i] = lastSlot;
+      m_HostCandidateParent[i] = lastIndex; // replaced by the slot below
       m_HostCandidateMoved[i] = static_cast<std::uint32_t>(movedPoints);
       movedPoints += c.element->points.size();
       m_HostFirstItem[i + 1] = m_HostFirstItem[i] + c.element->dependentTetrahedra.size();
@@ -403,6 +416,9 @@ private:
     const std::size_t items = m_HostFirstItem[n];
     if (items == 0)
       return 0;
+    const ParentSlots::Assignment slots = m_ParentSlots.Assign(parentKeys);
+    for (std::size_t i = 0; i < n; ++i)
+      m_HostCandidateParent[i] = slots.slot[m_HostCandidateParent[i]];
     m_HostMoved.Reserve(6 * movedPoints);
     m_Pool.ParallelFor(n, [&](std::size_t i) {
       const PartialCandidate & c = candidates[i];
@@ -413,16 +429,7 @@ private:
         out = std::copy(c.target[k].begin(), c.target[k].end(), out);
       }
     });
-    const std::size_t perParent = 6 * static_cast<std::size_t>(m_Batch.points);
-    m_HostParents.Reserve(parents.size() * perParent);
-    m_Pool.ParallelFor(parents.size(), [&](std::size_t slot) {
-      double * out = m_HostParents.Data() + slot * perParent;
-      for (const Vec3 & v : parents[slot]->source)
-        out = std::copy(v.begin(), v.end(), out);
-      for (const Vec3 & v : parents[slot]->target)
-        out = std::copy(v.begin(), v.end(), out);
-    });
-    m_Batch.parents = UploadAsync(m_HostParents.Data(), parents.size() * perParent, m_Parents);
+    UploadParents(parents, slots);
     m_Batch.elementPointOffsets = StageAndUpload(pointOffsets, m_HostElementPointOffsets, m_ElementPointOffsets);
     m_Batch.elementPoints = StageAndUpload(points, m_HostElementPoints, m_ElementPoints);
     m_Batch.elementTetrahedronOffsets =
@@ -436,6 +443,35 @@ private:
     m_MovedCount = 6 * movedPoints;
     m_Batch.candidates = n;
     return items;
+  }
+
+  /** Stages the parents `slots` names for upload and scatters them into
+   *  their slots of the device's parent store. */
+  void
+  UploadParents(const std::vector<const DualMesh *> & parents, const ParentSlots::Assignment & slots)
+  {
+    const std::size_t perParent = 6 * static_cast<std::size_t>(m_Batch.points);
+    if (slots.grown)
+      m_Parents.Reserve(slots.capacity * perParent);
+    m_Batch.parents = m_Parents.Data();
+    const std::size_t count = slots.upload.size();
+    m_Statistics.parentsUploaded += count;
+    if (count == 0)
+      return;
+    m_HostParents.Reserve(count * perParent);
+    m_HostParentSlots.Reserve(count);
+    m_Pool.ParallelFor(count, [&](std::size_t u) {
+      const DualMesh * parent = parents[slots.upload[u]];
+      double *         out = m_HostParents.Data() + u * perParent;
+      for (const Vec3 & v : parent->source)
+        out = std::copy(v.begin(), v.end(), out);
+      for (const Vec3 & v : parent->target)
+        out = std::copy(v.begin(), v.end(), out);
+      m_HostParentSlots[u] = slots.slot[slots.upload[u]];
+    });
+    const double *        staged = UploadAsync(m_HostParents.Data(), count * perParent, m_StagedParents);
+    const std::uint32_t * slotsOnDevice = UploadAsync(m_HostParentSlots.Data(), count, m_StagedParentSlots);
+    cuda::LaunchScatterParents(staged, slotsOnDevice, count, perParent, m_Parents.Data(), m_Stream->Get());
   }
 
   /** Stages which candidates are checked and their sides' seeds; false
@@ -616,6 +652,14 @@ private:
   }
 
   static double
+  ElapsedSeconds(const cuda::Event & from, const cuda::Event & to)
+  {
+    float milliseconds = 0.0f;
+    Check(cudaEventElapsedTime(&milliseconds, from.Get(), to.Get()), "reading an event");
+    return 1e-3 * milliseconds;
+  }
+
+  static double
   SecondsSince(std::chrono::steady_clock::time_point start)
   {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -633,22 +677,27 @@ private:
   void
   Run(std::size_t items)
   {
-    RunParts({ 0, items }, nullptr, [](std::size_t) {});
+    RunParts({ 0, items }, nullptr, Meanwhile{}, [](std::size_t) {});
   }
 
   /** Evaluates items [bounds[p], bounds[p + 1]) part after part and calls
    *  done(p), in order, once part p's values are on the host. On the texture
    *  path that is while the device samples part p + 1 (each part's first step
    *  is waited for anyway, to learn its number of chunks). Items whose
-   *  `itemSkip` byte is set (null: none) are not sampled. */
+   *  `itemSkip` byte is set (null: none) are not sampled. `meanwhile` (if
+   *  set) runs once the first part's kernels are queued. */
   void
-  RunParts(const std::vector<std::size_t> & bounds, const std::uint8_t * itemSkip,
+  RunParts(const std::vector<std::size_t> & bounds, const std::uint8_t * itemSkip, const Meanwhile & meanwhile,
            const std::function<void(std::size_t)> & done)
   {
     const std::size_t parts = bounds.size() - 1;
     const std::size_t items = bounds.back();
     if (items == 0)
     {
+      Check(cudaEventRecord(m_BatchEnd->Get(), m_Stream->Get()), "recording an event");
+      Check(cudaEventSynchronize(m_BatchEnd->Get()), "waiting for the batch");
+      if (meanwhile)
+        meanwhile();
       for (std::size_t p = 0; p < parts; ++p)
         done(p);
       return;
@@ -701,10 +750,13 @@ private:
                             count * 2 * cuda::DirectionValues * sizeof(double), cudaMemcpyDeviceToHost, copies),
             "copying values from the device");
       Check(cudaEventRecord(m_CopiedEvents[p]->Get(), copies), "recording an event");
+      if (p == 0 && meanwhile)
+        meanwhile();
       if (UsesTexturePath())
         for (; handed < p; ++handed)
           handOver(handed);
     }
+    Check(cudaEventRecord(m_BatchEnd->Get(), stream), "recording an event");
     Synchronize("evaluating tetrahedra");
     for (std::size_t p = 0; p < parts; ++p)
     {
@@ -756,6 +808,7 @@ private:
   std::unique_ptr<cuda::Stream> m_Stream;
   std::unique_ptr<cuda::Stream> m_CopyStream; ///< the parts' values back to the host
   std::unique_ptr<cuda::Event>  m_FoldStart, m_FoldEnd;
+  std::unique_ptr<cuda::Event>  m_BatchStart, m_BatchEnd; ///< an EvaluatePartials batch on the device
   std::vector<std::unique_ptr<cuda::Event>> m_PartEvents;   ///< each part's kernels: start, end
   std::vector<std::unique_ptr<cuda::Event>> m_CopiedEvents; ///< each part's values on the host
   cuda::EvaluationConstants     m_Constants;
@@ -773,7 +826,11 @@ private:
   cuda::DeviceArray<std::uint32_t> m_Mesh, m_ElementPointOffsets, m_ElementPoints, m_ElementTetrahedronOffsets,
     m_ElementTetrahedra, m_CandidateElement, m_CandidateParent, m_CandidateMoved;
   cuda::DeviceArray<std::uint64_t> m_FirstItem;
-  cuda::DeviceArray<double>        m_Parents, m_Moved;
+  ParentSlots                      m_ParentSlots;
+  cuda::DeviceArray<double>        m_Parents; ///< the parent store: slots of m_ParentSlots
+  cuda::DeviceArray<double>        m_StagedParents, m_Moved;
+  cuda::DeviceArray<std::uint32_t> m_StagedParentSlots;
+  cuda::PinnedArray<std::uint32_t> m_HostParentSlots;
   cuda::PinnedArray<std::uint32_t> m_HostElementPointOffsets, m_HostElementPoints, m_HostElementTetrahedronOffsets,
     m_HostElementTetrahedra, m_HostCandidateElement, m_HostCandidateParent, m_HostCandidateMoved;
   cuda::PinnedArray<std::uint64_t> m_HostFirstItem;

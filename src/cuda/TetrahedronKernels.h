@@ -129,6 +129,13 @@ void
 LaunchGatherCandidateCorners(const CandidateBatch & batch, std::size_t items, const FoldedCandidateSkip & skip,
                              double * corners, std::uint32_t * tetrahedra, std::uint8_t * itemSkip, void * stream);
 
+/** Copies parent i of `staged` (count x perParent doubles) to slot
+ *  slots[i] of `store` (perParent doubles per slot). Asynchronous on
+ *  `stream`. */
+void
+LaunchScatterParents(const double * staged, const std::uint32_t * slots, std::size_t count, std::size_t perParent,
+                     double * store, void * stream);
+
 /** Evaluates `items` tetrahedra with the exact (software) interpolation:
  *  `corners` (items x 24 doubles) and `tetrahedra` (items indices) on the
  *  device; writes `itemOut` (items x ItemValues) and `directionOut`

@@ -1,0 +1,53 @@
+// MultiObjectiveRegistration core: where a backend keeps the parents of
+// partial candidates between batches. Successive batches of a generation
+// share most of their parents (a batch changes the few solutions whose
+// candidates it accepts), so a backend that keeps each parent's points under
+// its key (PartialCandidate::parentKey) uploads only the parents it does not
+// hold. This is the bookkeeping, in plain C++: which slot of the store each
+// parent of a batch takes, and which parents must be uploaded.
+#ifndef morea_ParentSlots_h
+#define morea_ParentSlots_h
+
+#include <cstddef>
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+namespace morea
+{
+class ParentSlots
+{
+public:
+  struct Assignment
+  {
+    /** Per parent of the batch: its slot. Parents with one nonzero key share it. */
+    std::vector<std::uint32_t> slot;
+    /** The parents whose points must be uploaded into their slots, ascending;
+     *  one per slot. */
+    std::vector<std::size_t> upload;
+    /** The store must hold this many slots; when it grew, every slot's
+     *  contents are lost and all parents are in `upload`. */
+    std::size_t capacity{ 0 };
+    bool        grown{ false };
+  };
+
+  /** Slots for the parents of one batch, given their keys (0: kept for this
+   *  batch only). A slot whose parent the batch does not name is reused. */
+  Assignment
+  Assign(const std::vector<std::uint64_t> & keys);
+
+  std::size_t
+  Capacity() const
+  {
+    return m_KeyOfSlot.size();
+  }
+
+private:
+  std::unordered_map<std::uint64_t, std::uint32_t> m_SlotOfKey;
+  std::vector<std::uint64_t>                       m_KeyOfSlot;   ///< 0: nothing kept
+  std::vector<std::uint64_t>                       m_BatchOfSlot; ///< the last batch that used it
+  std::uint64_t                                    m_Batch{ 0 };
+};
+} // namespace morea
+
+#endif

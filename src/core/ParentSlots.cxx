@@ -1,0 +1,73 @@
+#include "morea/ParentSlots.h"
+
+#include <algorithm>
+
+namespace morea
+{
+ParentSlots::Assignment
+ParentSlots::Assign(const std::vector<std::uint64_t> & keys)
+{
+  ++m_Batch;
+  Assignment out;
+  out.slot.assign(keys.size(), 0);
+  // Parents already held: their slots are taken first.
+  std::size_t needed = 0;
+  {
+    std::unordered_map<std::uint64_t, bool> seen;
+    for (std::uint64_t k : keys)
+      if (k == 0 || seen.emplace(k, true).second)
+        ++needed;
+  }
+  if (needed > m_KeyOfSlot.size())
+  {
+    // A larger store starts empty (the device copy does not survive).
+    const std::size_t capacity = std::max(needed, m_KeyOfSlot.size() + m_KeyOfSlot.size() / 4);
+    m_SlotOfKey.clear();
+    m_KeyOfSlot.assign(capacity, 0);
+    m_BatchOfSlot.assign(capacity, 0);
+    out.grown = true;
+  }
+  out.capacity = m_KeyOfSlot.size();
+  std::vector<bool> held(keys.size(), false);
+  for (std::size_t i = 0; i < keys.size(); ++i)
+  {
+    if (keys[i] == 0)
+      continue;
+    const auto it = m_SlotOfKey.find(keys[i]);
+    if (it == m_SlotOfKey.end())
+      continue;
+    out.slot[i] = it->second;
+    m_BatchOfSlot[it->second] = m_Batch;
+    held[i] = true;
+  }
+  // The others take slots this batch does not use, in ascending order.
+  std::size_t next = 0;
+  for (std::size_t i = 0; i < keys.size(); ++i)
+  {
+    if (held[i])
+      continue;
+    if (keys[i] != 0)
+    {
+      // A second parent with a key given a slot earlier in this batch.
+      const auto it = m_SlotOfKey.find(keys[i]);
+      if (it != m_SlotOfKey.end() && m_BatchOfSlot[it->second] == m_Batch)
+      {
+        out.slot[i] = it->second;
+        continue;
+      }
+    }
+    while (m_BatchOfSlot[next] == m_Batch)
+      ++next;
+    const auto slot = static_cast<std::uint32_t>(next);
+    if (m_KeyOfSlot[slot] != 0)
+      m_SlotOfKey.erase(m_KeyOfSlot[slot]);
+    m_KeyOfSlot[slot] = keys[i];
+    if (keys[i] != 0)
+      m_SlotOfKey[keys[i]] = slot;
+    m_BatchOfSlot[slot] = m_Batch;
+    out.slot[i] = slot;
+    out.upload.push_back(i);
+  }
+  return out;
+}
+} // namespace morea
