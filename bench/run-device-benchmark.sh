@@ -6,9 +6,28 @@
 #   On the GPU:    bench/run-device-benchmark.sh run OUTDIR [morea benchmark options]
 #                  runs the CPU/CUDA agreement tests, then `morea benchmark` with
 #                  the paper's configuration; logs and JSON go to OUTDIR.
+#                  bench/run-device-benchmark.sh register|ab ...: `morea register` of
+#                  the same configuration, resumable, or several programs compared
+#                  over the same late generations (see below).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 DATA=${MOREA_DATA:-../shared/data/abdomen-cbct-pair}
+
+# register PROGRAM RUNDIR SECONDS BACKEND: `morea register` of the paper's
+# configuration on the bundled pair, resuming RUNDIR's checkpoint, stopped
+# (SIGKILL) after SECONDS; the log is appended to RUNDIR/register.log.
+register() {
+  local D=/tmp/b/data/abdomen
+  mkdir -p "$2"
+  timeout --signal=KILL "$3" "$1" register \
+    --fixed "$D/CB02.mha" --moving "$D/CB07.mha" \
+    --fixed-structure Stomach_duo_CBCT="$D/CB02_labels.mha:Stomach_duo_CBCT" \
+    --moving-structure Stomach_duo_CBCT="$D/CB07_masks/Stomach_duo_CBCT.mha" \
+    --fixed-structure Bowel_sm_CBCT="$D/CB02_labels.mha:Bowel_sm_CBCT" \
+    --moving-structure Bowel_sm_CBCT="$D/CB07_masks/Bowel_sm_CBCT.mha" \
+    --parameters bench/configurations/abdomen_paper.toml --backend "$4" \
+    --checkpoint-every 10 --resume -o "$2" >> "$2/register.log" 2>&1
+}
 case "${1:-}" in
   bundle)
     cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
@@ -50,22 +69,42 @@ case "${1:-}" in
     mkdir -p "$out" "$run" /tmp/b
     [ -x /tmp/b/bin/morea ] || tar xJf device-carry/bundle.tar.xz -C /tmp/b
     export LD_LIBRARY_PATH=/tmp/b/lib
-    D=/tmp/b/data/abdomen
     status=0
-    timeout --signal=KILL "$seconds" /tmp/b/bin/morea register \
-      --fixed "$D/CB02.mha" --moving "$D/CB07.mha" \
-      --fixed-structure Stomach_duo_CBCT="$D/CB02_labels.mha:Stomach_duo_CBCT" \
-      --moving-structure Stomach_duo_CBCT="$D/CB07_masks/Stomach_duo_CBCT.mha" \
-      --fixed-structure Bowel_sm_CBCT="$D/CB02_labels.mha:Bowel_sm_CBCT" \
-      --moving-structure Bowel_sm_CBCT="$D/CB07_masks/Bowel_sm_CBCT.mha" \
-      --parameters bench/configurations/abdomen_paper.toml --backend "$backend" \
-      --checkpoint-every 10 --resume -o "$run" >> "$run/register.log" 2>&1 || status=$?
+    register /tmp/b/bin/morea "$run" "$seconds" "$backend" || status=$?
     tail -c 4000 "$run/register.log" | tee "$out/register-tail.log"
     cp "$run"/generations.csv "$run"/summary.json "$run"/front.csv "$out/" 2>/dev/null || true
     echo "register exit status $status (137: stopped after $seconds s; call again to resume)"
     ;;
+  ab)
+    # Variants of morea over the same late generations: the bundle's morea
+    # registers for SECONDS, then every PROGRAM (e.g. device-carry/variants/*)
+    # resumes its own copy of that checkpoint to the end. Per program, its
+    # generations.csv, front.csv and log tail go to OUTDIR/NAME: the fronts of
+    # variants that compute the same must be equal byte for byte.
+    out=${2:?output folder}
+    seconds=${3:?seconds of the common start}
+    backend=${4:?backend}
+    shift 4
+    mkdir -p "$out" /tmp/b /tmp/ab
+    [ -x /tmp/b/bin/morea ] || tar xJf device-carry/bundle.tar.xz -C /tmp/b
+    export LD_LIBRARY_PATH=/tmp/b/lib
+    rm -rf /tmp/ab/start
+    register /tmp/b/bin/morea /tmp/ab/start "$seconds" "$backend" || true
+    tail -n 3 /tmp/ab/start/register.log > "$out/start-tail.log"
+    for program in "$@"; do
+      name=$(basename "$program")
+      rm -rf "/tmp/ab/$name"
+      cp -r /tmp/ab/start "/tmp/ab/$name"
+      mkdir -p "$out/$name"
+      register "$program" "/tmp/ab/$name" 600 "$backend" || true
+      tail -n 12 "/tmp/ab/$name/register.log" > "$out/$name/register-tail.log"
+      cp "/tmp/ab/$name"/generations.csv "/tmp/ab/$name"/front.csv "$out/$name/" 2>/dev/null || true
+      echo "$name: $(md5sum < "/tmp/ab/$name/front.csv" 2>/dev/null)"
+    done
+    ;;
   *)
-    echo "usage: $0 bundle | run OUTDIR [morea benchmark options] | register OUTDIR RUNDIR [SECONDS [BACKEND]]" >&2
+    echo "usage: $0 bundle | run OUTDIR [morea benchmark options] | register OUTDIR RUNDIR [SECONDS [BACKEND]]" \
+      "| ab OUTDIR SECONDS BACKEND PROGRAM..." >&2
     exit 2
     ;;
 esac
