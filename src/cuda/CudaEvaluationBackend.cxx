@@ -619,8 +619,6 @@ private:
     m_Tetrahedra.Reserve(items);
     m_ItemValues.Reserve(items * cuda::ItemValues);
     m_DirectionValues.Reserve(items * 2 * cuda::DirectionValues);
-    if (UsesTexturePath())
-      m_Workspace.Reserve(cuda::TexturePrepareWorkspaceBytes(items));
   }
 
   void
@@ -681,11 +679,10 @@ private:
   }
 
   /** Evaluates items [bounds[p], bounds[p + 1]) part after part and calls
-   *  done(p), in order, once part p's values are on the host. On the texture
-   *  path that is while the device samples part p + 1 (each part's first step
-   *  is waited for anyway, to learn its number of chunks). Items whose
-   *  `itemSkip` byte is set (null: none) are not sampled. `meanwhile` (if
-   *  set) runs once the first part's kernels are queued. */
+   *  done(p), in order, once part p's values are on the host, while the
+   *  device samples the later parts. Items whose `itemSkip` byte is set
+   *  (null: none) are not sampled. `meanwhile` (if set) runs once every
+   *  part's kernels are queued. */
   void
   RunParts(const std::vector<std::size_t> & bounds, const std::uint8_t * itemSkip, const Meanwhile & meanwhile,
            const std::function<void(std::size_t)> & done)
@@ -703,72 +700,87 @@ private:
       return;
     }
     cudaStream_t stream = m_Stream->Get(), copies = m_CopyStream->Get();
-    while (m_PartEvents.size() < 2 * parts)
+    while (m_PartEvents.size() < 4 * parts) // per part: step 1 start, end; step 2 start, end
       m_PartEvents.push_back(std::make_unique<cuda::Event>());
     while (m_CopiedEvents.size() < parts)
       m_CopiedEvents.push_back(std::make_unique<cuda::Event>());
-    // Part p's values on the host, then done(p).
-    const auto handOver = [&](std::size_t p) {
+    const auto event = [&](std::size_t p, int step) { return m_PartEvents[4 * p + step]->Get(); };
+    const auto count = [&](std::size_t p) { return bounds[p + 1] - bounds[p]; };
+    // Texture path: step 1 of every part first. One synchronisation then
+    // gives every part's number of chunks, and the parts' step 2 run back to
+    // back while the host hands the earlier ones over. (With one
+    // synchronisation per part, the device waited whenever handing a part
+    // over took longer than sampling the next.)
+    std::vector<std::size_t> chunks(parts, 0), workspaceAt(parts + 1, 0), chunkWorkspaceAt(parts + 1, 0);
+    if (UsesTexturePath())
+    {
+      for (std::size_t p = 0; p < parts; ++p)
+        workspaceAt[p + 1] = workspaceAt[p] + (cuda::TexturePrepareWorkspaceBytes(count(p)) + 255) / 256 * 256;
+      m_Workspace.Reserve(workspaceAt[parts]);
+      m_HostChunks.Reserve(parts);
+      for (std::size_t p = 0; p < parts; ++p)
+      {
+        Check(cudaEventRecord(event(p, 0), stream), "recording an event");
+        cuda::LaunchPrepareTexture(m_Constants, m_Corners.Data() + bounds[p] * cuda::ItemCorners,
+                                   m_Tetrahedra.Data() + bounds[p], itemSkip ? itemSkip + bounds[p] : nullptr,
+                                   count(p), m_Workspace.Data() + workspaceAt[p],
+                                   m_ItemValues.Data() + bounds[p] * cuda::ItemValues, m_HostChunks.Data() + p,
+                                   stream);
+        Check(cudaEventRecord(event(p, 1), stream), "recording an event");
+      }
+      Synchronize("preparing the texture sampling");
+      for (std::size_t p = 0; p < parts; ++p)
+      {
+        chunks[p] = m_HostChunks[p];
+        chunkWorkspaceAt[p + 1] = chunkWorkspaceAt[p] + cuda::TextureChunkWorkspaceBytes(chunks[p]);
+      }
+      m_ChunkWorkspace.Reserve(chunkWorkspaceAt[parts]);
+    }
+    for (std::size_t p = 0; p < parts; ++p)
+    {
+      const std::size_t begin = bounds[p];
+      double *          itemValues = m_ItemValues.Data() + begin * cuda::ItemValues;
+      double *          directionValues = m_DirectionValues.Data() + begin * 2 * cuda::DirectionValues;
+      Check(cudaEventRecord(event(p, 2), stream), "recording an event");
+      if (UsesTexturePath())
+        cuda::LaunchSampleTexture(m_Constants, count(p), m_Workspace.Data() + workspaceAt[p], chunks[p],
+                                  m_ChunkWorkspace.Data() + chunkWorkspaceAt[p], directionValues, stream);
+      else
+        cuda::LaunchEvaluateTetrahedra(m_Constants, m_Corners.Data() + begin * cuda::ItemCorners,
+                                       m_Tetrahedra.Data() + begin, itemSkip ? itemSkip + begin : nullptr, count(p),
+                                       itemValues, directionValues, stream);
+      Check(cudaEventRecord(event(p, 3), stream), "recording an event");
+      // The values go back on the copy stream, so that the next part's
+      // kernels do not wait for the transfer (about 70 bytes per tetrahedron).
+      Check(cudaStreamWaitEvent(copies, event(p, 3), 0), "ordering a copy after its part");
+      Check(cudaMemcpyAsync(m_HostItemValues.Data() + begin * cuda::ItemValues, itemValues,
+                            count(p) * cuda::ItemValues * sizeof(double), cudaMemcpyDeviceToHost, copies),
+            "copying values from the device");
+      Check(cudaMemcpyAsync(m_HostDirectionValues.Data() + begin * 2 * cuda::DirectionValues, directionValues,
+                            count(p) * 2 * cuda::DirectionValues * sizeof(double), cudaMemcpyDeviceToHost, copies),
+            "copying values from the device");
+      Check(cudaEventRecord(m_CopiedEvents[p]->Get(), copies), "recording an event");
+    }
+    Check(cudaEventRecord(m_BatchEnd->Get(), stream), "recording an event");
+    if (meanwhile)
+      meanwhile();
+    // Part p's values on the host, then done(p), while later parts sample.
+    for (std::size_t p = 0; p < parts; ++p)
+    {
       const auto start = std::chrono::steady_clock::now();
       Check(cudaEventSynchronize(m_CopiedEvents[p]->Get()), "copying values from the device");
       m_Statistics.waitSeconds += SecondsSince(start);
       done(p);
-    };
-    std::size_t handed = 0;
-    for (std::size_t p = 0; p < parts; ++p)
-    {
-      const std::size_t begin = bounds[p], count = bounds[p + 1] - bounds[p];
-      const double *    corners = m_Corners.Data() + begin * cuda::ItemCorners;
-      double *          itemValues = m_ItemValues.Data() + begin * cuda::ItemValues;
-      double *          directionValues = m_DirectionValues.Data() + begin * 2 * cuda::DirectionValues;
-      Check(cudaEventRecord(m_PartEvents[2 * p]->Get(), stream), "recording an event");
-      if (UsesTexturePath())
-      {
-        // Step 1 tells how many chunks step 2 has: one synchronisation,
-        // after which the earlier parts are done too.
-        cuda::LaunchPrepareTexture(m_Constants, corners, m_Tetrahedra.Data() + begin,
-                                   itemSkip ? itemSkip + begin : nullptr, count, m_Workspace.Data(),
-                                   itemValues, m_HostChunks.Data(), stream);
-        Synchronize("preparing the texture sampling");
-        const std::size_t chunks = m_HostChunks[0];
-        m_ChunkWorkspace.Reserve(cuda::TextureChunkWorkspaceBytes(chunks));
-        cuda::LaunchSampleTexture(m_Constants, count, m_Workspace.Data(), chunks, m_ChunkWorkspace.Data(),
-                                  directionValues, stream);
-      }
-      else
-        cuda::LaunchEvaluateTetrahedra(m_Constants, corners, m_Tetrahedra.Data() + begin,
-                                       itemSkip ? itemSkip + begin : nullptr, count, itemValues,
-                                       directionValues, stream);
-      Check(cudaEventRecord(m_PartEvents[2 * p + 1]->Get(), stream), "recording an event");
-      // The values go back on the copy stream, so that the next part's
-      // kernels do not wait for the transfer (about 70 bytes per tetrahedron).
-      Check(cudaStreamWaitEvent(copies, m_PartEvents[2 * p + 1]->Get(), 0), "ordering a copy after its part");
-      Check(cudaMemcpyAsync(m_HostItemValues.Data() + begin * cuda::ItemValues, itemValues,
-                            count * cuda::ItemValues * sizeof(double), cudaMemcpyDeviceToHost, copies),
-            "copying values from the device");
-      Check(cudaMemcpyAsync(m_HostDirectionValues.Data() + begin * 2 * cuda::DirectionValues, directionValues,
-                            count * 2 * cuda::DirectionValues * sizeof(double), cudaMemcpyDeviceToHost, copies),
-            "copying values from the device");
-      Check(cudaEventRecord(m_CopiedEvents[p]->Get(), copies), "recording an event");
-      if (p == 0 && meanwhile)
-        meanwhile();
-      if (UsesTexturePath())
-        for (; handed < p; ++handed)
-          handOver(handed);
     }
-    Check(cudaEventRecord(m_BatchEnd->Get(), stream), "recording an event");
     Synchronize("evaluating tetrahedra");
     for (std::size_t p = 0; p < parts; ++p)
     {
-      float milliseconds = 0.0f;
-      Check(cudaEventElapsedTime(&milliseconds, m_PartEvents[2 * p]->Get(), m_PartEvents[2 * p + 1]->Get()),
-            "reading an event");
-      m_Statistics.kernelSeconds += 1e-3 * milliseconds;
+      if (UsesTexturePath())
+        m_Statistics.kernelSeconds += ElapsedSeconds(*m_PartEvents[4 * p], *m_PartEvents[4 * p + 1]);
+      m_Statistics.kernelSeconds += ElapsedSeconds(*m_PartEvents[4 * p + 2], *m_PartEvents[4 * p + 3]);
     }
     ++m_Statistics.batches;
     m_Statistics.tetrahedra += items;
-    for (; handed < parts; ++handed)
-      handOver(handed);
   }
 
   /** Unpacks items [first[i], first[i + 1]) into out(i) for every i on the
