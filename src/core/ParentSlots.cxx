@@ -1,6 +1,7 @@
 #include "morea/ParentSlots.h"
 
 #include <algorithm>
+#include <unordered_set>
 
 namespace morea
 {
@@ -10,12 +11,12 @@ ParentSlots::Assign(const std::vector<std::uint64_t> & keys)
   ++m_Batch;
   Assignment out;
   out.slot.assign(keys.size(), 0);
-  // Parents already held: their slots are taken first.
+  // Slots the batch needs: one per distinct nonzero key, one per key 0.
   std::size_t needed = 0;
   {
-    std::unordered_map<std::uint64_t, bool> seen;
+    std::unordered_set<std::uint64_t> seen;
     for (std::uint64_t k : keys)
-      if (k == 0 || seen.emplace(k, true).second)
+      if (k == 0 || seen.insert(k).second)
         ++needed;
   }
   if (needed > m_KeyOfSlot.size())
@@ -28,6 +29,7 @@ ParentSlots::Assign(const std::vector<std::uint64_t> & keys)
     out.grown = true;
   }
   out.capacity = m_KeyOfSlot.size();
+  // Parents already held keep their slots; those are taken first.
   std::vector<bool> held(keys.size(), false);
   for (std::size_t i = 0; i < keys.size(); ++i)
   {

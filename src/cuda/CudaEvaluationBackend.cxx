@@ -538,9 +538,7 @@ private:
   void
   ReadFoldChecks(const std::vector<PartialCandidate> & candidates)
   {
-    float milliseconds = 0.0f;
-    Check(cudaEventElapsedTime(&milliseconds, m_FoldStart->Get(), m_FoldEnd->Get()), "reading an event");
-    m_Statistics.foldSeconds += 1e-3 * milliseconds;
+    m_Statistics.foldSeconds += ElapsedSeconds(*m_FoldStart, *m_FoldEnd);
     for (std::size_t i = 0; i < candidates.size(); ++i)
     {
       const PartialCandidate & c = candidates[i];

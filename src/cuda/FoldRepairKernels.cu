@@ -137,13 +137,35 @@ FacePlaneDistance(const double * const f[3], const double * x, double & distance
   return true;
 }
 
+/** The mean of the face-plane distances of x, summed in the order the
+ *  faces are added (degenerate faces left out), as RepairPoints sums them. */
+struct MeanFaceDistance
+{
+  double        sum{ 0.0 };
+  std::uint32_t n{ 0 };
+
+  __device__ void
+  AddFace(const double * const f[3], const double * x)
+  {
+    double distance = 0.0;
+    if (!FacePlaneDistance(f, x, distance))
+      return;
+    sum = Add(sum, distance);
+    ++n;
+  }
+  __device__ double
+  Value() const
+  {
+    return n ? Div(sum, static_cast<double>(n)) : 0.0;
+  }
+};
+
 /** Mean distance of p to the planes of the faces opposite it. */
 __device__ double
 DistanceToSurroundingPolyhedron(const FoldRepairConstants & k, const SideView & s, std::uint32_t p)
 {
-  const double * x = s.Point(p);
-  double         sum = 0.0;
-  std::uint32_t  n = 0;
+  const double *   x = s.Point(p);
+  MeanFaceDistance mean;
   for (std::uint32_t i = k.pointTetrahedronOffsets[p]; i < k.pointTetrahedronOffsets[p + 1]; ++i)
   {
     const std::uint32_t t = k.pointTetrahedra[i];
@@ -155,13 +177,9 @@ DistanceToSurroundingPolyhedron(const FoldRepairConstants & k, const SideView & 
       if (v != p)
         f[m++] = s.Point(v);
     }
-    double distance = 0.0;
-    if (!FacePlaneDistance(f, x, distance))
-      continue;
-    sum = Add(sum, distance);
-    ++n;
+    mean.AddFace(f, x);
   }
-  return n ? Div(sum, static_cast<double>(n)) : 0.0;
+  return mean.Value();
 }
 
 /** The tetrahedra around one point as the repair's trials see them: every
@@ -261,18 +279,13 @@ StarViolation(const FoldRepairConstants & k, const PointStar & star, const doubl
 __device__ double
 StarDistance(const PointStar & star, const double * x)
 {
-  double        sum = 0.0;
-  std::uint32_t n = 0;
+  MeanFaceDistance mean;
   for (std::uint32_t i = 0; i < star.count; ++i)
   {
     const double * f[3] = { star.corners[i], star.corners[i] + 3, star.corners[i] + 6 };
-    double         distance = 0.0;
-    if (!FacePlaneDistance(f, x, distance))
-      continue;
-    sum = Add(sum, distance);
-    ++n;
+    mean.AddFace(f, x);
   }
-  return n ? Div(sum, static_cast<double>(n)) : 0.0;
+  return mean.Value();
 }
 
 /** Trial `trial` of point p (pin `pin`) around `original`, in the domain. */
