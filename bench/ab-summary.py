@@ -8,7 +8,7 @@ import sys
 
 root, first, last = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
 columns = ["seconds", "seconds_sampling", "seconds_fold_checks", "seconds_evaluation", "seconds_acceptance",
-           "seconds_modelling", "seconds_device_kernels"]
+           "seconds_modelling", "seconds_device_kernels", "seconds_device_span"]
 print("program".ljust(22) + "".join(c.replace("seconds_", "")[:12].rjust(13) for c in columns))
 for name in sorted(os.listdir(root)):
     path = os.path.join(root, name, "generations.csv")
@@ -17,5 +17,5 @@ for name in sorted(os.listdir(root)):
     rows = [r for r in csv.DictReader(open(path)) if first <= int(r["generation"]) <= last]
     if not rows:
         continue
-    means = [sum(float(r[c]) for r in rows) / len(rows) for c in columns]
+    means = [sum(float(r.get(c) or 0) for r in rows) / len(rows) for c in columns]
     print(name.ljust(22) + "".join(f"{m:13.4f}" for m in means) + f"   ({len(rows)} generations)")

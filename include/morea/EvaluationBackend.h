@@ -90,6 +90,20 @@ struct BackendStatistics
   /** CUDA only: parents uploaded by EvaluatePartials (those whose key it
    *  did not hold, see PartialCandidate::parentKey). */
   std::uint64_t parentsUploaded{ 0 };
+  /** CUDA only: where the device time of the EvaluatePartials batches goes,
+   *  between events on its stream. A phase in which the stream is empty
+   *  counts the host's time: `betweenBatches` and `staging` are the device
+   *  waiting for the host. */
+  struct DevicePhases
+  {
+    double betweenBatches{ 0.0 }; ///< a batch's end to the next one's start
+    double staging{ 0.0 };        ///< start to the first upload: the host packing the batch
+    double uploads{ 0.0 };        ///< fold-check staging, candidates and parents to the device
+    double foldChecks{ 0.0 };     ///< checks and repair
+    double preparation{ 0.0 };    ///< corners and the sampling set-up of all parts
+    double chunkCounts{ 0.0 };    ///< the host reading the chunk counts, queueing the sampling
+    double sampling{ 0.0 };       ///< the first sampling kernel's start to the batch's end
+  } devicePhases;
 };
 
 class EvaluationBackend

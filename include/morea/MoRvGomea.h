@@ -94,6 +94,10 @@ struct GenerationRecord
    *  0 on the CPU backend) and its sample points, both directions: the
    *  kernels' share of the generation and their throughput. */
   double deviceKernelSeconds{ 0.0 };
+  /** The device time from the first upload to the last kernel of each
+   *  partial-evaluation batch (0 on the CPU backend): the generation's time
+   *  beyond it the device waited for the host. */
+  double deviceSpanSeconds{ 0.0 };
   double samples{ 0.0 };
 };
 

@@ -36,28 +36,48 @@ Since(Clock::time_point start)
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-/** One backend's run: `generations` generations from the seeded start. */
+/** One backend's run: `generations` generations from the seeded start, or
+ *  from a checkpoint of `morea register` (late generations). */
 nlohmann::json
 TimeBackend(const std::string & name, const itk::morea::MeshModel & model, const TetrahedronEvaluator & evaluator,
             const GomeaOptions & gomea, const InitialPopulationOptions & initial, std::size_t generations,
-            std::size_t threads)
+            std::size_t threads, const std::string & checkpoint)
 {
   const std::size_t memoryBefore = CudaMemoryInUse();
   std::size_t       memoryPeak = memoryBefore;
   auto              backend = CreateEvaluationBackend(ParseBackendChoice(name), evaluator, threads);
   std::cout << "  backend " << backend->Name() << ": initial population of " << gomea.populationSize << "\n"
             << std::flush;
-  auto                 start = Clock::now();
-  std::vector<DualMesh> population =
-    GenerateInitialPopulation(model.base, evaluator.Constraint(), gomea.populationSize, gomea.seed, initial);
-  const double secondsPopulation = Since(start);
-  start = Clock::now();
+  auto      start = Clock::now();
   MoRvGomea optimiser(model.base, model.topology, model.parallel, evaluator.Constraint(), *backend, gomea);
-  optimiser.Initialize(std::move(population));
+  double    secondsPopulation = 0.0;
+  if (checkpoint.empty())
+  {
+    std::vector<DualMesh> population =
+      GenerateInitialPopulation(model.base, evaluator.Constraint(), gomea.populationSize, gomea.seed, initial);
+    secondsPopulation = Since(start);
+    start = Clock::now();
+    optimiser.Initialize(std::move(population));
+  }
+  else
+    optimiser.LoadCheckpoint(checkpoint);
   const double            secondsInitialEvaluation = Since(start);
+  const std::size_t       firstGeneration = optimiser.Generation();
   const BackendStatistics afterInit = backend->Statistics();
   memoryPeak = std::max(memoryPeak, CudaMemoryInUse());
 
+  // The device's phases between two readings of the statistics.
+  const auto DevicePhasesJson = [](const BackendStatistics & before, const BackendStatistics & after) {
+    const auto & a = after.devicePhases;
+    const auto & b = before.devicePhases;
+    return nlohmann::json{ { "between_batches", a.betweenBatches - b.betweenBatches },
+                           { "staging", a.staging - b.staging },
+                           { "uploads", a.uploads - b.uploads },
+                           { "fold_checks", a.foldChecks - b.foldChecks },
+                           { "preparation", a.preparation - b.preparation },
+                           { "chunk_counts", a.chunkCounts - b.chunkCounts },
+                           { "sampling", a.sampling - b.sampling } };
+  };
   nlohmann::json perGeneration = nlohmann::json::array();
   start = Clock::now();
   for (std::size_t g = 0; g < generations && !optimiser.Finished(); ++g)
@@ -82,6 +102,7 @@ TimeBackend(const std::string & name, const itk::morea::MeshModel & model, const
                               { "batches", after.batches - before.batches },
                               { "parents_uploaded", after.parentsUploaded - before.parentsUploaded },
                               { "batch_span_seconds", after.batchSpanSeconds - before.batchSpanSeconds },
+                              { "device_phase_seconds", DevicePhasesJson(before, after) },
                               { "best_guidance", r.bestGuidance },
                               { "hypervolume", r.hypervolume },
                               { "archive", r.archiveSize },
@@ -118,6 +139,7 @@ TimeBackend(const std::string & name, const itk::morea::MeshModel & model, const
   const std::size_t       done = perGeneration.size();
   nlohmann::json          out{ { "backend", backend->Name() },
                       { "threads", threads ? threads : std::max(1u, std::thread::hardware_concurrency()) },
+                      { "first_generation", firstGeneration },
                       { "seconds_initial_population", secondsPopulation },
                       { "seconds_initial_evaluation", secondsInitialEvaluation },
                       { "generations", done },
@@ -131,6 +153,7 @@ TimeBackend(const std::string & name, const itk::morea::MeshModel & model, const
                       { "samples_per_second_wall", secondsGenerations > 0 ? samples / secondsGenerations : 0.0 },
                       { "samples_per_second_kernel", kernel > 0 ? samples / kernel : 0.0 },
                       { "gpu_memory_peak_bytes", memoryPeak - memoryBefore },
+                      { "device_phase_seconds", DevicePhasesJson(afterInit, total) },
                       { "archive_size", optimiser.Archive().Size() },
                       { "per_generation", perGeneration } };
   return out;
@@ -150,6 +173,7 @@ AddBenchmarkCommand(CLI::App & app)
     std::size_t      cpuGenerations{ 2 };
     std::size_t      threads{ 0 };
     bool             probe{ true };
+    std::string      checkpoint;
   };
   auto   options = std::make_shared<Options>();
   auto * cmd = app.add_subcommand("benchmark", "time MO-RV-GOMEA with the CUDA and CPU backends on a problem");
@@ -162,6 +186,9 @@ AddBenchmarkCommand(CLI::App & app)
   cmd->add_option("--cpu-generations", options->cpuGenerations, "generations of the CPU run (the same first ones)")
     ->capture_default_str();
   cmd->add_option("--threads", options->threads, "CPU threads (0: all)")->capture_default_str();
+  cmd->add_option("--from-checkpoint", options->checkpoint,
+                  "start each run from this checkpoint of `morea register` (the same problem and parameters)")
+    ->check(CLI::ExistingFile);
   cmd->add_option("--probe", options->probe, "measure the GPU's coherent trilinear fetch rate")->capture_default_str();
   cmd->callback([options] {
     const auto parameters = options->parameters.Load();
@@ -210,7 +237,8 @@ AddBenchmarkCommand(CLI::App & app)
       const std::size_t generations =
         name == "cpu" ? options->cpuGenerations : (options->generations ? options->generations : gomea.generations);
       std::cout << "timing " << name << " for " << generations << " generations\n";
-      report["runs"][name] = TimeBackend(name, model, evaluator, gomea, initial, generations, options->threads);
+      report["runs"][name] = TimeBackend(name, model, evaluator, gomea, initial, generations, options->threads,
+                                          options->checkpoint);
     }
     if (report.contains("runs") && report["runs"].contains("cuda") && report["runs"].contains("cpu"))
     {

@@ -703,9 +703,9 @@ MoRvGomea::ProcessCandidates(CandidateBatch & candidateBatch, GenerationRecord &
   //    values then.
   std::vector<PartialCandidate> batch(candidates.size());
   std::vector<CandidateFolds>   folds(candidates.size());
-  for (std::size_t i = 0; i < candidates.size(); ++i)
-  {
-    Candidate &        c = candidates[i];
+  // In parallel: the device waits for this (a batch holds tens of thousands).
+  m_Pool->ParallelFor(candidates.size(), [&](std::size_t i) {
+    const Candidate &  c = candidates[i];
     PartialCandidate & p = batch[i];
     p.parent = &m_Population[c.solution];
     // An id names one set of points (a change gets a new id, a donor's
@@ -718,7 +718,7 @@ MoRvGomea::ProcessCandidates(CandidateBatch & candidateBatch, GenerationRecord &
     p.folds = &folds[i];
     p.seed = c.seed;
     p.evaluateFolded = std::llround(m_Totals[c.solution].sum.folded) != 0;
-  }
+  });
   // 2. Acceptance of each part of the batch as the backend hands it over
   //    (in order), while the device may still compute the next part.
   std::vector<bool> changed(m_Population.size(), false);
@@ -1100,6 +1100,7 @@ MoRvGomea::RunGeneration()
   summary.phaseSeconds.bookkeeping = SecondsSince(bookkeeping) - forcedSeconds;
   summary.seconds = SecondsSince(start);
   summary.deviceKernelSeconds = m_Backend.Statistics().kernelSeconds - backendBefore.kernelSeconds;
+  summary.deviceSpanSeconds = m_Backend.Statistics().batchSpanSeconds - backendBefore.batchSpanSeconds;
   summary.samples = m_Backend.Statistics().samples - backendBefore.samples;
   m_History.push_back(summary);
 }

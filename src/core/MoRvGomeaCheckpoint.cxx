@@ -20,7 +20,7 @@ namespace morea
 namespace
 {
 constexpr char          Magic[8] = { 'M', 'O', 'R', 'E', 'A', 'C', 'K', 'P' };
-constexpr std::uint32_t Version = 2; // 2: GenerationRecord has device kernel seconds and samples
+constexpr std::uint32_t Version = 3; // 2: GenerationRecord has device kernel seconds and samples; 3: and the device span
 
 class Writer
 {

@@ -69,6 +69,8 @@ public:
     m_FoldEnd = std::make_unique<cuda::Event>();
     m_BatchStart = std::make_unique<cuda::Event>();
     m_BatchEnd = std::make_unique<cuda::Event>();
+    m_PreviousBatchEnd = std::make_unique<cuda::Event>();
+    m_Staged = std::make_unique<cuda::Event>();
     m_HostChunks.Reserve(1);
     cuda::UploadSobolDirections(SobolDirectionNumbers());
 
@@ -82,6 +84,7 @@ public:
     m_Constants.voxelVolume = data.voxelVolume;
     m_Constants.elasticity = evaluator.Elasticity().empty() ? nullptr : Upload(evaluator.Elasticity(), m_Elasticity);
     m_Constants.referenceVolumes = Upload(evaluator.Constraint().ReferenceVolumes(), m_ReferenceVolumes);
+    m_Constants.tetrahedra = static_cast<std::uint32_t>(evaluator.Constraint().ReferenceVolumes().size());
     m_Constants.volumeFraction = evaluator.Constraint().VolumeFraction();
     if (data.moving.channels <= 4)
     {
@@ -194,6 +197,8 @@ public:
     const bool  checks = items > 0 && StageFoldChecks(candidates);
     if (checks)
       LaunchFoldChecks(candidates.size());
+    else
+      Check(cudaEventRecord(m_FoldEnd->Get(), m_Stream->Get()), "recording an event");
     if (items > 0)
     {
       Reserve(items);
@@ -257,6 +262,8 @@ public:
     });
     m_Statistics.tetrahedra -= skippedItems;
     m_Statistics.batchSpanSeconds += ElapsedSeconds(*m_BatchStart, *m_BatchEnd);
+    if (items > 0)
+      AddDevicePhases(checks, itemBounds.size() - 1);
     m_Statistics.seconds += SecondsSince(start);
   }
 
@@ -371,6 +378,8 @@ private:
     // into pinned memory.
     std::unordered_map<const DualMesh *, std::uint32_t>   parentIndex;
     std::unordered_map<const FosElement *, std::uint32_t> elementSlot;
+    std::vector<const FosElement *>                       slotElements; ///< per slot
+    std::uint32_t                                         lastSlot = 0;
     std::vector<const DualMesh *>                         parents;
     std::vector<std::uint64_t>                            parentKeys;
     std::vector<std::uint32_t> pointOffsets{ 0 }, points, tetrahedronOffsets{ 0 }, dependent;
@@ -399,15 +408,26 @@ private:
         lastParent = c.parent;
         lastIndex = p.first->second;
       }
-      const auto e = elementSlot.try_emplace(c.element, static_cast<std::uint32_t>(pointOffsets.size() - 1));
-      if (e.second)
+      // Each solution's candidates mostly take the elements in the order of
+      // the one before: try the slot after the last one before the map.
+      const std::uint32_t slots = static_cast<std::uint32_t>(slotElements.size());
+      std::uint32_t       slot = slots > 0 ? (lastSlot + 1) % slots : 0;
+      if (slots == 0 || slotElements[slot] != c.element)
       {
-        points.insert(points.end(), c.element->points.begin(), c.element->points.end());
-        pointOffsets.push_back(static_cast<std::uint32_t>(points.size()));
-        dependent.insert(dependent.end(), c.element->dependentTetrahedra.begin(), c.element->dependentTetrahedra.end());
-        tetrahedronOffsets.push_back(static_cast<std::uint32_t>(dependent.size()));
+        const auto e = elementSlot.try_emplace(c.element, slots);
+        slot = e.first->second;
+        if (e.second)
+        {
+          slotElements.push_back(c.element);
+          points.insert(points.end(), c.element->points.begin(), c.element->points.end());
+          pointOffsets.push_back(static_cast<std::uint32_t>(points.size()));
+          dependent.insert(dependent.end(), c.element->dependentTetrahedra.begin(),
+                           c.element->dependentTetrahedra.end());
+          tetrahedronOffsets.push_back(static_cast<std::uint32_t>(dependent.size()));
+        }
       }
-      m_HostCandidateElement[i] = e.first->second;
+      lastSlot = slot;
+      m_HostCandidateElement[i] = slot;
       m_HostCandidateParent[i] = lastIndex; // replaced by the slot below
       m_HostCandidateMoved[i] = static_cast<std::uint32_t>(movedPoints);
       movedPoints += c.element->points.size();
@@ -429,6 +449,7 @@ private:
         out = std::copy(c.target[k].begin(), c.target[k].end(), out);
       }
     });
+    Check(cudaEventRecord(m_Staged->Get(), m_Stream->Get()), "recording an event");
     UploadParents(parents, slots);
     m_Batch.elementPointOffsets = StageAndUpload(pointOffsets, m_HostElementPointOffsets, m_ElementPointOffsets);
     m_Batch.elementPoints = StageAndUpload(points, m_HostElementPoints, m_ElementPoints);
@@ -661,6 +682,28 @@ private:
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
 
+  /** Adds the last batch's phases to the statistics (see
+   *  BackendStatistics::DevicePhases); `checks`: whether the fold kernel ran. */
+  void
+  AddDevicePhases(bool checks, std::size_t parts)
+  {
+    auto &     phases = m_Statistics.devicePhases;
+    const auto part = [&](std::size_t p, int step) -> const cuda::Event & { return *m_PartEvents[4 * p + step]; };
+    if (m_HasPreviousBatch)
+      phases.betweenBatches += ElapsedSeconds(*m_PreviousBatchEnd, *m_BatchStart);
+    phases.staging += ElapsedSeconds(*m_BatchStart, *m_Staged);
+    const double fold = checks ? ElapsedSeconds(*m_FoldStart, *m_FoldEnd) : 0.0;
+    phases.uploads += ElapsedSeconds(*m_Staged, *m_FoldEnd) - fold;
+    phases.foldChecks += fold;
+    const cuda::Event & prepared = UsesTexturePath() ? part(parts - 1, 1) : part(0, 2);
+    phases.preparation += ElapsedSeconds(*m_FoldEnd, prepared);
+    if (UsesTexturePath())
+      phases.chunkCounts += ElapsedSeconds(prepared, part(0, 2));
+    phases.sampling += ElapsedSeconds(part(0, 2), *m_BatchEnd);
+    std::swap(m_PreviousBatchEnd, m_BatchEnd);
+    m_HasPreviousBatch = true;
+  }
+
   /** Waits for the stream, counting the host's waiting time. */
   void
   Synchronize(const char * what)
@@ -679,8 +722,9 @@ private:
   /** Evaluates items [bounds[p], bounds[p + 1]) part after part and calls
    *  done(p), in order, once part p's values are on the host, while the
    *  device samples the later parts. Items whose `itemSkip` byte is set
-   *  (null: none) are not sampled. `meanwhile` (if set) runs once every
-   *  part's kernels are queued. */
+   *  (null: none) are not sampled. `meanwhile` (if set) runs once the
+   *  device has work: on the texture path while it prepares the parts (their
+   *  chunk counts are read after it), otherwise once every part is queued. */
   void
   RunParts(const std::vector<std::size_t> & bounds, const std::uint8_t * itemSkip, const Meanwhile & meanwhile,
            const std::function<void(std::size_t)> & done)
@@ -726,6 +770,11 @@ private:
                                    stream);
         Check(cudaEventRecord(event(p, 1), stream), "recording an event");
       }
+      // The host's own work for the next batch while the device checks folds
+      // and prepares: it used to wait here, then draw while the parts were
+      // sampled, and hand the last part over late.
+      if (meanwhile)
+        meanwhile();
       Synchronize("preparing the texture sampling");
       for (std::size_t p = 0; p < parts; ++p)
       {
@@ -760,7 +809,7 @@ private:
       Check(cudaEventRecord(m_CopiedEvents[p]->Get(), copies), "recording an event");
     }
     Check(cudaEventRecord(m_BatchEnd->Get(), stream), "recording an event");
-    if (meanwhile)
+    if (meanwhile && !UsesTexturePath())
       meanwhile();
     // Part p's values on the host, then done(p), while later parts sample.
     for (std::size_t p = 0; p < parts; ++p)
@@ -819,6 +868,9 @@ private:
   std::unique_ptr<cuda::Stream> m_CopyStream; ///< the parts' values back to the host
   std::unique_ptr<cuda::Event>  m_FoldStart, m_FoldEnd;
   std::unique_ptr<cuda::Event>  m_BatchStart, m_BatchEnd; ///< an EvaluatePartials batch on the device
+  std::unique_ptr<cuda::Event>  m_Staged;           ///< recorded before the batch's first upload
+  std::unique_ptr<cuda::Event>  m_PreviousBatchEnd; ///< the last batch's end, if m_HasPreviousBatch
+  bool                          m_HasPreviousBatch{ false };
   std::vector<std::unique_ptr<cuda::Event>> m_PartEvents;   ///< each part's kernels: start, end
   std::vector<std::unique_ptr<cuda::Event>> m_CopiedEvents; ///< each part's values on the host
   cuda::EvaluationConstants     m_Constants;

@@ -66,6 +66,7 @@ struct EvaluationConstants
   double          voxelVolume{ 1.0 };
   const double *  elasticity{ nullptr };       ///< per tetrahedron, or null (all 1)
   const double *  referenceVolumes{ nullptr }; ///< signed base volume per tetrahedron
+  std::uint32_t   tetrahedra{ 0 };             ///< of the mesh
   double          volumeFraction{ 0.0 };
   /** Set when the images have at most 4 channels: the fast kernels use these. */
   bool             packed{ false };

@@ -533,9 +533,14 @@ LaunchPrepareTexture(const EvaluationConstants & constants, const double * corne
   PrepareTextureTasks<<<blocks, PrepareThreads, 0, s>>>(constants, corners, tetrahedra, itemSkip, items, w.tasks,
                                                         w.chunkCounts, w.itemIndex, itemOut);
   Check(cudaGetLastError(), "launching the texture set-up kernel");
+  // Only the bits a tetrahedron index can have: 2 passes instead of 4 for
+  // a few thousand tetrahedra (ScratchBytes sized the sort for all 32).
+  int keyBits = constants.tetrahedra == 0 ? 32 : 1; // 0: not known
+  while (keyBits < 32 && (std::uint64_t{ 1 } << keyBits) < constants.tetrahedra)
+    ++keyBits;
   std::size_t bytes = w.scratchBytes;
   Check(cub::DeviceRadixSort::SortPairs(w.scratch, bytes, tetrahedra, w.sortedKeys, w.itemIndex, w.sortedItems,
-                                        static_cast<int>(items), 0, 32, s),
+                                        static_cast<int>(items), 0, keyBits, s),
         "sorting the schedule by tetrahedron");
   const std::size_t tasks = 2 * items;
   const unsigned    taskBlocks = static_cast<unsigned>((tasks + 255) / 256);
