@@ -533,7 +533,7 @@ private:
   }
 
   /** The fold kernel, then its outcome and the repaired points back to the
-   *  host on the stream (read after the evaluation's synchronisation). On
+   *  host (read when the first part is handed over). On
    *  the sampling stream, before the corners: run part by part on a second
    *  stream beside the sampling, the two kernels slowed each other down more
    *  than they overlapped (H100, paper configuration: 192.9 s against
@@ -548,11 +548,15 @@ private:
     cuda::LaunchCheckCandidateFolds(m_Batch, m_Folds, m_FoldCheck, m_SideSeeds, m_Moved.Data(), m_Outcome.Data(),
                                     stream);
     Check(cudaEventRecord(m_FoldEnd->Get(), stream), "recording an event");
-    Check(cudaMemcpyAsync(m_HostOutcome.Data(), m_Outcome.Data(), 2 * candidates, cudaMemcpyDeviceToHost, stream),
+    // Back on the copy stream, so that the corners need not wait for the
+    // transfer; read after part 0's values, which follow on that stream.
+    cudaStream_t copies = m_CopyStream->Get();
+    Check(cudaStreamWaitEvent(copies, m_FoldEnd->Get(), 0), "ordering the fold checks' copy after them");
+    Check(cudaMemcpyAsync(m_HostOutcome.Data(), m_Outcome.Data(), 2 * candidates, cudaMemcpyDeviceToHost, copies),
           "copying fold checks from the device");
     if (m_Folds.repair)
       Check(cudaMemcpyAsync(m_HostMoved.Data(), m_Moved.Data(), m_MovedCount * sizeof(double),
-                            cudaMemcpyDeviceToHost, stream),
+                            cudaMemcpyDeviceToHost, copies),
             "copying repaired points from the device");
   }
 
