@@ -1,6 +1,11 @@
+#!/usr/bin/env python3
+"""Summary of one run of a `morea benchmark` JSON (BACKEND, or the first): seconds per
+generation, and per generation the device phases (device_phase_seconds), the
+batch span, the backend's host time and the optimiser's phases.
+Usage: bench/device-phases.py BENCHMARK_JSON [BACKEND]"""
 import json,sys
 d=json.load(open(sys.argv[1]))
-r=d['runs']['cuda-texture']
+r=d['runs'][sys.argv[2]] if len(sys.argv) > 2 else next(iter(d['runs'].values()))
 print('first gen',r.get('first_generation'),'gens',r['generations'],'s/gen',r['seconds_per_generation'],'kernels/gen',r['seconds_in_kernels']/r['generations'])
 g=r['per_generation']; n=len(g)
 keys=g[0]['device_phase_seconds'].keys()

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The CUDA benchmark on a GPU machine without ITK (see bench/README.md).
+# The CUDA benchmark on a GPU machine without ITK (see README.md, "CUDA backend").
 #   Here:          bench/run-device-benchmark.sh bundle
 #                  builds morea and the core tests (CUDA for sm_90), packs them with
 #                  their libraries and the abdominal CBCT pair into device-carry/.
@@ -9,6 +9,9 @@
 #                  bench/run-device-benchmark.sh register|ab ...: `morea register` of
 #                  the same configuration, resumable, or several programs compared
 #                  over the same late generations (see below).
+#   Late generations in detail: `morea benchmark ... --from-checkpoint RUNDIR/checkpoint.bin`
+#                  times the generations after a register checkpoint; bench/device-phases.py
+#                  JSON prints where the device's time went (device_phase_seconds).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 DATA=${MOREA_DATA:-../shared/data/abdomen-cbct-pair}

@@ -393,6 +393,11 @@ expect_failure("register: resume from a damaged checkpoint" OUTPUTS ${o}/front.c
   ARGS register --fixed "${fixed}" --moving "${moving}" ${blob} --set ea_population_size=8 --set ea_num_clusters=2
        --set ea_num_generations=2 --set morea_mesh_num_points=40 --set preprocess_rigid_structure=none --resume -o "${WORK}/register-bad-checkpoint")
 file(REMOVE_RECURSE "${WORK}/register-bad-checkpoint")
+file(WRITE "${WORK}/benchmark-bad-checkpoint.bin" "MOREACKP but not a checkpoint")
+expect_failure("benchmark: start from a damaged checkpoint" OUTPUTS "${WORK}/benchmark-out.json" FRAGMENTS "checkpoint"
+  ARGS benchmark --fixed "${fixed}" --moving "${moving}" ${blob} --set ea_population_size=8 --set ea_num_clusters=2
+       --set morea_mesh_num_points=40 --set preprocess_rigid_structure=none --backends cpu --probe 0
+       --from-checkpoint "${WORK}/benchmark-bad-checkpoint.bin" -o "${WORK}/benchmark-out.json")
 expect_failure("mesh: too few points" USAGE OUTPUTS ${o} FRAGMENTS "morea_mesh_num_points"
   ARGS mesh --fixed "${fixed}" --moving "${moving}" ${blob} --set morea_mesh_num_points=4 -o "${o}")
 

@@ -270,6 +270,24 @@ if(reg_fold GREATER 0)
   message(FATAL_ERROR "register: the best-guidance solution folds (Jacobian <= 0 in ${reg_fold} of the voxels)")
 endif()
 
+file(READ "${reg}/generations.csv" gen_csv)
+if(NOT gen_csv MATCHES "seconds_device_kernels,seconds_device_span,samples")
+  message(FATAL_ERROR "register: generations.csv lacks the device span column")
+endif()
+
+# --- benchmark: late generations from the register run's checkpoint -----------------------------------
+set(bench_json "${WORK}/benchmark-late.json")
+morea_ok("benchmark --from-checkpoint" benchmark --problem "${phantom}" ${tiny} --set ea_num_generations=8
+  --backends cpu --cpu-generations 2 --probe 0 --from-checkpoint "${reg}/checkpoint.bin" -o "${bench_json}")
+file(READ "${bench_json}" late_json)
+json_number(late_first "benchmark JSON" "${late_json}" runs cpu first_generation)
+json_number(late_count "benchmark JSON" "${late_json}" runs cpu generations)
+json_number(late_generation "benchmark JSON" "${late_json}" runs cpu per_generation 0 generation)
+if(NOT late_first EQUAL 6 OR NOT late_count EQUAL 2 OR NOT late_generation EQUAL 7)
+  message(FATAL_ERROR "benchmark --from-checkpoint: started at generation ${late_first} and ran ${late_count} "
+                      "(first ${late_generation}); expected 6, 2 and 7")
+endif()
+
 # Killed and resumed: the same seed ends with the same front as one uninterrupted run.
 set(full "${WORK}/register-full")
 morea_ok("register (uninterrupted)" register --problem "${phantom}" ${tiny} --set ea_num_generations=30
