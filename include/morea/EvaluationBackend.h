@@ -83,10 +83,6 @@ struct BackendStatistics
   double stagingSeconds{ 0.0 };
   double waitSeconds{ 0.0 };
   double unpackSeconds{ 0.0 };
-  /** CUDA only: device time from each EvaluatePartials batch's first upload
-   *  to its last kernel's end; the rest of the wall time the device waited
-   *  for the host between batches. */
-  double batchSpanSeconds{ 0.0 };
   /** CUDA only: parents uploaded by EvaluatePartials (those whose key it
    *  did not hold, see PartialCandidate::parentKey). */
   std::uint64_t parentsUploaded{ 0 };
@@ -104,6 +100,16 @@ struct BackendStatistics
     double chunkCounts{ 0.0 };    ///< the host reading the chunk counts, queueing the sampling
     double sampling{ 0.0 };       ///< the first sampling kernel's start to the batch's end
   } devicePhases;
+
+  /** CUDA only: device time from each EvaluatePartials batch's start to its
+   *  last kernel's end (every phase but `betweenBatches`); the rest of the
+   *  wall time the device waited for the host between batches. */
+  double
+  BatchSpanSeconds() const
+  {
+    const DevicePhases & p = devicePhases;
+    return p.staging + p.uploads + p.foldChecks + p.preparation + p.chunkCounts + p.sampling;
+  }
 };
 
 class EvaluationBackend

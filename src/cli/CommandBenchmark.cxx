@@ -101,7 +101,7 @@ TimeBackend(const std::string & name, const itk::morea::MeshModel & model, const
                               { "samples", after.samples - before.samples },
                               { "batches", after.batches - before.batches },
                               { "parents_uploaded", after.parentsUploaded - before.parentsUploaded },
-                              { "batch_span_seconds", after.batchSpanSeconds - before.batchSpanSeconds },
+                              { "batch_span_seconds", after.BatchSpanSeconds() - before.BatchSpanSeconds() },
                               { "device_phase_seconds", DevicePhasesJson(before, after) },
                               { "best_guidance", r.bestGuidance },
                               { "hypervolume", r.hypervolume },
@@ -124,7 +124,7 @@ TimeBackend(const std::string & name, const itk::morea::MeshModel & model, const
               << after.stagingSeconds - before.stagingSeconds << ", waiting " << after.waitSeconds - before.waitSeconds
               << ", unpacking " << after.unpackSeconds - before.unpackSeconds << ", parents uploaded "
               << after.parentsUploaded - before.parentsUploaded << ", batch spans "
-              << after.batchSpanSeconds - before.batchSpanSeconds << "; sampling " << r.phaseSeconds.sampling
+              << after.BatchSpanSeconds() - before.BatchSpanSeconds() << "; sampling " << r.phaseSeconds.sampling
               << ", folds " << r.phaseSeconds.foldChecks << ", acceptance " << r.phaseSeconds.acceptance
               << ", forced " << r.phaseSeconds.forcedImprovements << ", modelling " << r.phaseSeconds.modelling
               << ", bookkeeping " << r.phaseSeconds.bookkeeping << "), best guidance " << std::defaultfloat

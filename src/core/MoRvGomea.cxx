@@ -1100,7 +1100,7 @@ MoRvGomea::RunGeneration()
   summary.phaseSeconds.bookkeeping = SecondsSince(bookkeeping) - forcedSeconds;
   summary.seconds = SecondsSince(start);
   summary.deviceKernelSeconds = m_Backend.Statistics().kernelSeconds - backendBefore.kernelSeconds;
-  summary.deviceSpanSeconds = m_Backend.Statistics().batchSpanSeconds - backendBefore.batchSpanSeconds;
+  summary.deviceSpanSeconds = m_Backend.Statistics().BatchSpanSeconds() - backendBefore.BatchSpanSeconds();
   summary.samples = m_Backend.Statistics().samples - backendBefore.samples;
   m_History.push_back(summary);
 }

@@ -261,7 +261,6 @@ public:
         ready(candidateBounds[p], candidateBounds[p + 1]);
     });
     m_Statistics.tetrahedra -= skippedItems;
-    m_Statistics.batchSpanSeconds += ElapsedSeconds(*m_BatchStart, *m_BatchEnd);
     if (items > 0)
       AddDevicePhases(checks, itemBounds.size() - 1);
     m_Statistics.seconds += SecondsSince(start);
