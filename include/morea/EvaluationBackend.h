@@ -167,6 +167,20 @@ public:
   EvaluatePartials(const std::vector<PartialCandidate> & candidates, const ReadyCandidates & ready,
                    const Meanwhile & meanwhile) = 0;
 
+  /** Lets the backend pack, while it evaluates the current batch, what of
+   *  the next EvaluatePartials call depends neither on the parents' points
+   *  nor on their keys: elements, moved points, seeds and which candidates
+   *  are checked. For `meanwhile`. The call it prepares must pass candidates
+   *  with the same parents, elements, point and output arrays and seeds, in
+   *  the same order; their keys and `evaluateFolded` may change until then.
+   *  A backend finding the call different packs it afresh. Does nothing by
+   *  default. */
+  virtual void
+  PrepareNextPartials(const std::vector<PartialCandidate> & next)
+  {
+    static_cast<void>(next);
+  }
+
   /** Fold checks and repair of later EvaluatePartials calls; the constraint
    *  and base mesh must outlive them. */
   virtual void

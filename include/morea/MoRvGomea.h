@@ -204,6 +204,11 @@ private:
                 RandomGenerator & random);
   void
   EstimateDistributions(std::vector<ClusterModel> & clusters) const;
+  /** The backend's view of a drawn batch (PartialCandidate per candidate),
+   *  but for what the batch before it may still change: parent keys and
+   *  whether a folded candidate is evaluated (ProcessCandidates sets them). */
+  void
+  BuildPartials(CandidateBatch & batch) const;
   /** Repairs (when enabled) and evaluates `candidates`, then accepts them in
    *  order; returns how many were accepted. */
   std::size_t

@@ -180,6 +180,11 @@ struct MoRvGomea::CandidateBatch
   std::vector<Vec3>              source, target;
   std::vector<double>            samples; ///< drawn variables (before projection), for the ratio test
   std::vector<TetrahedronValues> values;
+  /** The backend's view of the candidates and their fold outcomes
+   *  (BuildPartials); `partialsBuilt` until ProcessCandidates uses them. */
+  std::vector<PartialCandidate> partials;
+  std::vector<CandidateFolds>   folds;
+  bool                          partialsBuilt{ false };
 
   /** Places each candidate's data; storage only grows. */
   void
@@ -692,6 +697,29 @@ MoRvGomea::SampleCandidates(CandidateBatch & batch, const std::vector<ClusterMod
   });
 }
 
+void
+MoRvGomea::BuildPartials(CandidateBatch & candidateBatch) const
+{
+  const std::vector<Candidate> & candidates = candidateBatch.candidates;
+  std::vector<PartialCandidate> & batch = candidateBatch.partials;
+  batch.resize(candidates.size());
+  candidateBatch.folds.assign(candidates.size(), CandidateFolds{});
+  m_Pool->ParallelFor(candidates.size(), [&](std::size_t i) {
+    const Candidate &  c = candidates[i];
+    PartialCandidate & p = batch[i];
+    p.parent = &m_Population[c.solution];
+    p.parentKey = 0;
+    p.element = &m_Parallel.elements[c.element];
+    p.source = candidateBatch.Source(c);
+    p.target = candidateBatch.Target(c);
+    p.values = candidateBatch.Values(c);
+    p.folds = &candidateBatch.folds[i];
+    p.seed = c.seed;
+    p.evaluateFolded = true;
+  });
+  candidateBatch.partialsBuilt = true;
+}
+
 std::size_t
 MoRvGomea::ProcessCandidates(CandidateBatch & candidateBatch, GenerationRecord & record,
                              const EvaluationBackend::Meanwhile & meanwhile)
@@ -700,23 +728,20 @@ MoRvGomea::ProcessCandidates(CandidateBatch & candidateBatch, GenerationRecord &
   // 1. Fold checks (and repair) and evaluation of the whole batch at once,
   //    in the backend (the GPU checks where the points already are). A
   //    candidate still folded cannot replace a fold-free parent: it needs no
-  //    values then.
-  std::vector<PartialCandidate> batch(candidates.size());
-  std::vector<CandidateFolds>   folds(candidates.size());
+  //    values then. Built while the batch before was evaluated, where it was
+  //    drawn then; what that batch's acceptance changes is set here.
+  if (!candidateBatch.partialsBuilt)
+    BuildPartials(candidateBatch);
+  candidateBatch.partialsBuilt = false;
+  std::vector<PartialCandidate> &    batch = candidateBatch.partials;
+  const std::vector<CandidateFolds> & folds = candidateBatch.folds;
   // In parallel: the device waits for this (a batch holds tens of thousands).
   m_Pool->ParallelFor(candidates.size(), [&](std::size_t i) {
     const Candidate &  c = candidates[i];
     PartialCandidate & p = batch[i];
-    p.parent = &m_Population[c.solution];
     // An id names one set of points (a change gets a new id, a donor's
     // points keep the donor's), so the key lets the backend keep parents.
     p.parentKey = std::max<std::uint64_t>(1, HashCombine(m_KeySalt, m_Ids[c.solution]));
-    p.element = &m_Parallel.elements[c.element];
-    p.source = candidateBatch.Source(c);
-    p.target = candidateBatch.Target(c);
-    p.values = candidateBatch.Values(c);
-    p.folds = &folds[i];
-    p.seed = c.seed;
     p.evaluateFolded = std::llround(m_Totals[c.solution].sum.folded) != 0;
   });
   // 2. Acceptance of each part of the batch as the backend hands it over
@@ -1010,7 +1035,15 @@ MoRvGomea::RunGeneration()
     CandidateBatch & batch = *m_Batch;
     EvaluationBackend::Meanwhile drawNext;
     if (i + 1 < groupOrder.size())
-      drawNext = [&, i] { drawBatch(groupOrder[i + 1], *m_NextBatch); };
+      drawNext = [&, i] {
+        drawBatch(groupOrder[i + 1], *m_NextBatch);
+        // The backend packs what it can of the next batch now: what this
+        // batch's acceptance changes (parents, their keys) comes later.
+        const auto staging = std::chrono::steady_clock::now();
+        BuildPartials(*m_NextBatch);
+        m_Backend.PrepareNextPartials(m_NextBatch->partials);
+        record.phaseSeconds.evaluation += SecondsSince(staging);
+      };
     ProcessCandidates(batch, record, drawNext);
     for (const Candidate & cand : batch.candidates)
       if (cand.accepted)

@@ -52,6 +52,63 @@ struct VolumeTextures
 
 static_assert(NearContourBlocks::BlockSize == cuda::NearBlockSize, "the sampling kernel's blocks are the core's");
 
+/** A batch of partial candidates packed on the host for the device, but for
+ *  what depends on the parents' points and keys. Packed by
+ *  PrepareNextPartials while the device works on the batch before (or by
+ *  EvaluatePartials itself); two alternate, so that packing the next batch
+ *  leaves alone the arrays of the one in flight (its first items, moved
+ *  points and their offsets are read until it ends). */
+struct HostCandidates
+{
+  /** What each candidate was packed from: a call with other candidates is packed afresh. */
+  struct Signature
+  {
+    const DualMesh *       parent;
+    const FosElement *     element;
+    const Vec3 *           source;
+    const Vec3 *           target;
+    const CandidateFolds * folds;
+    std::uint64_t          seed;
+
+    bool
+    operator==(const Signature & o) const
+    {
+      return parent == o.parent && element == o.element && source == o.source && target == o.target &&
+             folds == o.folds && seed == o.seed;
+    }
+  };
+  static Signature
+  SignatureOf(const PartialCandidate & c)
+  {
+    return { c.parent, c.element, c.source, c.target, c.folds, c.seed };
+  }
+
+  bool
+  PackedFor(const std::vector<PartialCandidate> & candidates) const
+  {
+    if (!prepared || signatures.size() != candidates.size())
+      return false;
+    for (std::size_t i = 0; i < candidates.size(); ++i)
+      if (!(signatures[i] == SignatureOf(candidates[i])))
+        return false;
+    return true;
+  }
+
+  bool                           prepared{ false }; ///< by PrepareNextPartials, not yet used
+  std::vector<Signature>         signatures;
+  std::vector<const DualMesh *>  parents;        ///< distinct, in order of first use
+  std::vector<std::size_t>       parentFirstUse; ///< per parent: its first candidate
+  std::vector<std::uint32_t>     pointOffsets, points, tetrahedronOffsets, dependent; ///< per element slot
+  cuda::PinnedArray<std::uint32_t> candidateElement, candidateParent, candidateMoved; ///< slot, parent, first point
+  cuda::PinnedArray<std::uint64_t> firstItem;                                          ///< per candidate, and the end
+  cuda::PinnedArray<double>        moved; ///< 6 per moved point; the repaired ones come back here
+  std::size_t                      movedPoints{ 0 };
+  bool                             anyChecked{ false };     ///< some candidate asks for a fold check
+  std::size_t                      largestChecked{ 0 };     ///< points of the largest checked element
+  cuda::PinnedArray<std::uint8_t>  foldCheck;               ///< per candidate
+  cuda::PinnedArray<std::uint64_t> sideSeeds;               ///< per candidate side
+};
+
 class CudaEvaluationBackend final : public EvaluationBackend
 {
 public:
@@ -193,10 +250,15 @@ public:
   {
     const auto  start = std::chrono::steady_clock::now();
     Check(cudaEventRecord(m_BatchStart->Get(), m_Stream->Get()), "recording an event");
-    const auto  items = UploadCandidates(candidates);
-    const bool  checks = items > 0 && StageFoldChecks(candidates);
+    HostCandidates & host = m_HostCandidates[1 - m_CurrentHost];
+    if (!host.PackedFor(candidates))
+      PackCandidates(candidates, host);
+    host.prepared = false;
+    m_CurrentHost = 1 - m_CurrentHost;
+    const auto  items = UploadCandidates(candidates, host);
+    const bool  checks = items > 0 && StageFoldChecks(candidates, host);
     if (checks)
-      LaunchFoldChecks(candidates.size());
+      LaunchFoldChecks(candidates.size(), host);
     else
       Check(cudaEventRecord(m_FoldEnd->Get(), m_Stream->Get()), "recording an event");
     if (items > 0)
@@ -214,8 +276,8 @@ public:
       cuda::LaunchGatherCandidateCorners(m_Batch, items, skip, m_Corners.Data(), m_Tetrahedra.Data(),
                                          m_ItemSkip.Data(), m_Stream->Get());
     }
-    // Each candidate's first item, as staged by UploadCandidates.
-    const std::uint64_t * first = m_HostFirstItem.Data();
+    // Each candidate's first item, as packed.
+    const std::uint64_t * first = host.firstItem.Data();
     // Parts of whole candidates with about equal numbers of items, the last
     // one smaller.
     const std::size_t        parts = std::clamp<std::size_t>(items / MinItemsPerPart, 1, MaxParts);
@@ -243,7 +305,7 @@ public:
       if (!foldsRead)
       {
         if (checks)
-          ReadFoldChecks(candidates);
+          ReadFoldChecks(candidates, host);
         else
           for (const PartialCandidate & c : candidates)
             if (c.folds)
@@ -264,6 +326,16 @@ public:
     if (items > 0)
       AddDevicePhases(checks, itemBounds.size() - 1);
     m_Statistics.seconds += SecondsSince(start);
+  }
+
+  void
+  PrepareNextPartials(const std::vector<PartialCandidate> & next) override
+  {
+    const auto start = std::chrono::steady_clock::now();
+    HostCandidates & host = m_HostCandidates[1 - m_CurrentHost];
+    PackCandidates(next, host);
+    host.prepared = true;
+    m_Statistics.stagingSeconds += SecondsSince(start);
   }
 
 private:
@@ -365,45 +437,50 @@ private:
     return view;
   }
 
-  /** Uploads the batch's parents (those the device does not hold, see
-   *  PartialCandidate::parentKey), elements (each once), candidate table and
-   *  moved points; returns the number of items. */
-  std::size_t
-  UploadCandidates(const std::vector<PartialCandidate> & candidates)
+  /** Packs the candidate table, the elements (each once), the moved points
+   *  and the fold checks' flags and seeds; the parents only by identity. */
+  void
+  PackCandidates(const std::vector<PartialCandidate> & candidates, HostCandidates & h)
   {
     // The table in one light serial pass (a batch holds each solution's
     // candidates one after another, so the parent lookup is mostly the
-    // previous one); the bulk (coordinates, parents) in parallel, straight
-    // into pinned memory.
+    // previous one); the bulk (coordinates) in parallel, straight into
+    // pinned memory.
     std::unordered_map<const DualMesh *, std::uint32_t>   parentIndex;
     std::unordered_map<const FosElement *, std::uint32_t> elementSlot;
     std::vector<const FosElement *>                       slotElements; ///< per slot
     std::uint32_t                                         lastSlot = 0;
-    std::vector<const DualMesh *>                         parents;
-    std::vector<std::uint64_t>                            parentKeys;
-    std::vector<std::uint32_t> pointOffsets{ 0 }, points, tetrahedronOffsets{ 0 }, dependent;
-    const std::size_t          n = candidates.size();
-    m_HostCandidateElement.Reserve(std::max<std::size_t>(1, n));
-    m_HostCandidateParent.Reserve(std::max<std::size_t>(1, n));
-    m_HostCandidateMoved.Reserve(std::max<std::size_t>(1, n));
-    m_HostFirstItem.Reserve(n + 1);
-    m_HostFirstItem[0] = 0;
+    const std::size_t                                     n = candidates.size();
+    h.prepared = false;
+    h.signatures.resize(n);
+    h.parents.clear();
+    h.parentFirstUse.clear();
+    h.pointOffsets.assign(1, 0);
+    h.points.clear();
+    h.tetrahedronOffsets.assign(1, 0);
+    h.dependent.clear();
+    h.candidateElement.Reserve(std::max<std::size_t>(1, n));
+    h.candidateParent.Reserve(std::max<std::size_t>(1, n));
+    h.candidateMoved.Reserve(std::max<std::size_t>(1, n));
+    h.firstItem.Reserve(n + 1);
+    h.firstItem[0] = 0;
+    h.anyChecked = false;
+    h.largestChecked = 0;
     const DualMesh * lastParent = nullptr;
     std::uint32_t    lastIndex = 0;
     std::size_t      movedPoints = 0;
     for (std::size_t i = 0; i < n; ++i)
     {
       const PartialCandidate & c = candidates[i];
+      h.signatures[i] = HostCandidates::SignatureOf(c);
       if (c.parent != lastParent)
       {
-        const auto p = parentIndex.try_emplace(c.parent, static_cast<std::uint32_t>(parents.size()));
+        const auto p = parentIndex.try_emplace(c.parent, static_cast<std::uint32_t>(h.parents.size()));
         if (p.second)
         {
-          parents.push_back(c.parent);
-          parentKeys.push_back(c.parentKey);
+          h.parents.push_back(c.parent);
+          h.parentFirstUse.push_back(i);
         }
-        else if (parentKeys[p.first->second] != c.parentKey)
-          throw Error("evaluation backend: one parent with two keys in a batch");
         lastParent = c.parent;
         lastIndex = p.first->second;
       }
@@ -418,49 +495,81 @@ private:
         if (e.second)
         {
           slotElements.push_back(c.element);
-          points.insert(points.end(), c.element->points.begin(), c.element->points.end());
-          pointOffsets.push_back(static_cast<std::uint32_t>(points.size()));
-          dependent.insert(dependent.end(), c.element->dependentTetrahedra.begin(),
-                           c.element->dependentTetrahedra.end());
-          tetrahedronOffsets.push_back(static_cast<std::uint32_t>(dependent.size()));
+          h.points.insert(h.points.end(), c.element->points.begin(), c.element->points.end());
+          h.pointOffsets.push_back(static_cast<std::uint32_t>(h.points.size()));
+          h.dependent.insert(h.dependent.end(), c.element->dependentTetrahedra.begin(),
+                             c.element->dependentTetrahedra.end());
+          h.tetrahedronOffsets.push_back(static_cast<std::uint32_t>(h.dependent.size()));
         }
       }
       lastSlot = slot;
-      m_HostCandidateElement[i] = slot;
-      m_HostCandidateParent[i] = lastIndex; // replaced by the slot below
-      m_HostCandidateMoved[i] = static_cast<std::uint32_t>(movedPoints);
+      h.candidateElement[i] = slot;
+      h.candidateParent[i] = lastIndex;
+      h.candidateMoved[i] = static_cast<std::uint32_t>(movedPoints);
       movedPoints += c.element->points.size();
-      m_HostFirstItem[i + 1] = m_HostFirstItem[i] + c.element->dependentTetrahedra.size();
+      h.firstItem[i + 1] = h.firstItem[i] + c.element->dependentTetrahedra.size();
+      if (c.folds)
+      {
+        h.anyChecked = true;
+        h.largestChecked = std::max(h.largestChecked, c.element->points.size());
+      }
     }
-    const std::size_t items = m_HostFirstItem[n];
-    if (items == 0)
-      return 0;
-    const ParentSlots::Assignment slots = m_ParentSlots.Assign(parentKeys);
-    for (std::size_t i = 0; i < n; ++i)
-      m_HostCandidateParent[i] = slots.slot[m_HostCandidateParent[i]];
-    m_HostMoved.Reserve(6 * movedPoints);
+    h.movedPoints = movedPoints;
+    h.moved.Reserve(std::max<std::size_t>(1, 6 * movedPoints));
+    if (h.anyChecked)
+    {
+      h.foldCheck.Reserve(n);
+      h.sideSeeds.Reserve(2 * n);
+    }
     m_Pool.ParallelFor(n, [&](std::size_t i) {
       const PartialCandidate & c = candidates[i];
-      double *                 out = m_HostMoved.Data() + 6 * static_cast<std::size_t>(m_HostCandidateMoved[i]);
+      double *                 out = h.moved.Data() + 6 * static_cast<std::size_t>(h.candidateMoved[i]);
       for (std::size_t k = 0; k < c.element->points.size(); ++k)
       {
         out = std::copy(c.source[k].begin(), c.source[k].end(), out);
         out = std::copy(c.target[k].begin(), c.target[k].end(), out);
       }
+      if (h.anyChecked)
+      {
+        h.foldCheck[i] = c.folds ? 1 : 0;
+        h.sideSeeds[2 * i] = c.folds ? RepairSeed(c.seed, 0) : 0;
+        h.sideSeeds[2 * i + 1] = c.folds ? RepairSeed(c.seed, 1) : 0;
+      }
     });
+  }
+
+  /** Uploads the packed batch and its parents (those the device does not
+   *  hold, see PartialCandidate::parentKey); returns the number of items. */
+  std::size_t
+  UploadCandidates(const std::vector<PartialCandidate> & candidates, HostCandidates & h)
+  {
+    const std::size_t n = candidates.size();
+    const std::size_t items = h.firstItem[n];
+    if (items == 0)
+      return 0;
+    std::vector<std::uint64_t> parentKeys(h.parents.size());
+    for (std::size_t p = 0; p < h.parents.size(); ++p)
+      parentKeys[p] = candidates[h.parentFirstUse[p]].parentKey;
+    for (std::size_t i = 0; i < n; ++i)
+      if (candidates[i].parentKey != parentKeys[h.candidateParent[i]])
+        throw Error("evaluation backend: one parent with two keys in a batch");
+    const ParentSlots::Assignment slots = m_ParentSlots.Assign(parentKeys);
+    m_HostCandidateSlot.Reserve(n);
+    for (std::size_t i = 0; i < n; ++i)
+      m_HostCandidateSlot[i] = slots.slot[h.candidateParent[i]];
     Check(cudaEventRecord(m_Staged->Get(), m_Stream->Get()), "recording an event");
-    UploadParents(parents, slots);
-    m_Batch.elementPointOffsets = StageAndUpload(pointOffsets, m_HostElementPointOffsets, m_ElementPointOffsets);
-    m_Batch.elementPoints = StageAndUpload(points, m_HostElementPoints, m_ElementPoints);
+    UploadParents(h.parents, slots);
+    m_Batch.elementPointOffsets = StageAndUpload(h.pointOffsets, m_HostElementPointOffsets, m_ElementPointOffsets);
+    m_Batch.elementPoints = StageAndUpload(h.points, m_HostElementPoints, m_ElementPoints);
     m_Batch.elementTetrahedronOffsets =
-      StageAndUpload(tetrahedronOffsets, m_HostElementTetrahedronOffsets, m_ElementTetrahedronOffsets);
-    m_Batch.elementTetrahedra = StageAndUpload(dependent, m_HostElementTetrahedra, m_ElementTetrahedra);
-    m_Batch.candidateElement = UploadAsync(m_HostCandidateElement.Data(), n, m_CandidateElement);
-    m_Batch.candidateParent = UploadAsync(m_HostCandidateParent.Data(), n, m_CandidateParent);
-    m_Batch.candidateMoved = UploadAsync(m_HostCandidateMoved.Data(), n, m_CandidateMoved);
-    m_Batch.candidateFirstItem = UploadAsync(m_HostFirstItem.Data(), n + 1, m_FirstItem);
-    m_Batch.moved = UploadAsync(m_HostMoved.Data(), 6 * movedPoints, m_Moved);
-    m_MovedCount = 6 * movedPoints;
+      StageAndUpload(h.tetrahedronOffsets, m_HostElementTetrahedronOffsets, m_ElementTetrahedronOffsets);
+    m_Batch.elementTetrahedra = StageAndUpload(h.dependent, m_HostElementTetrahedra, m_ElementTetrahedra);
+    m_Batch.candidateElement = UploadAsync(h.candidateElement.Data(), n, m_CandidateElement);
+    m_Batch.candidateParent = UploadAsync(m_HostCandidateSlot.Data(), n, m_CandidateParent);
+    m_Batch.candidateMoved = UploadAsync(h.candidateMoved.Data(), n, m_CandidateMoved);
+    m_Batch.candidateFirstItem = UploadAsync(h.firstItem.Data(), n + 1, m_FirstItem);
+    m_Batch.moved = UploadAsync(h.moved.Data(), 6 * h.movedPoints, m_Moved);
+    m_MovedCount = 6 * h.movedPoints;
     m_Batch.candidates = n;
     return items;
   }
@@ -494,40 +603,26 @@ private:
     cuda::LaunchScatterParents(staged, slotsOnDevice, count, perParent, m_Parents.Data(), m_Stream->Get());
   }
 
-  /** Stages which candidates are checked and their sides' seeds; false
-   *  when no candidate of the batch asks for a check. */
+  /** Uploads which candidates are checked, which of them need no values
+   *  when left folded, and their sides' seeds; false when no candidate of
+   *  the batch asks for a check. */
   bool
-  StageFoldChecks(const std::vector<PartialCandidate> & candidates)
+  StageFoldChecks(const std::vector<PartialCandidate> & candidates, const HostCandidates & h)
   {
-    if (!m_FoldHandling.constraint)
+    if (!m_FoldHandling.constraint || !h.anyChecked)
       return false;
+    if (h.largestChecked > cuda::MaxRepairElementPoints)
+      throw Error("CUDA backend: fold checks handle elements of up to " + std::to_string(cuda::MaxRepairElementPoints) +
+                  " points, not " + std::to_string(h.largestChecked));
     const std::size_t n = candidates.size();
-    bool              any = false;
-    for (const PartialCandidate & c : candidates)
-    {
-      if (!c.folds)
-        continue;
-      if (c.element->points.size() > cuda::MaxRepairElementPoints)
-        throw Error("CUDA backend: fold checks handle elements of up to " +
-                    std::to_string(cuda::MaxRepairElementPoints) + " points, not " +
-                    std::to_string(c.element->points.size()));
-      any = true;
-    }
-    if (!any)
-      return false;
-    m_HostFoldCheck.Reserve(n);
     m_HostSkipIfFolded.Reserve(n);
-    m_HostSideSeeds.Reserve(2 * n);
     m_Pool.ParallelFor(n, [&](std::size_t i) {
       const PartialCandidate & c = candidates[i];
-      m_HostFoldCheck[i] = c.folds ? 1 : 0;
       m_HostSkipIfFolded[i] = c.folds && !c.evaluateFolded ? 1 : 0;
-      m_HostSideSeeds[2 * i] = c.folds ? RepairSeed(c.seed, 0) : 0;
-      m_HostSideSeeds[2 * i + 1] = c.folds ? RepairSeed(c.seed, 1) : 0;
     });
-    m_FoldCheck = UploadAsync(m_HostFoldCheck.Data(), n, m_FoldCheckDevice);
+    m_FoldCheck = UploadAsync(h.foldCheck.Data(), n, m_FoldCheckDevice);
     m_SkipIfFolded = UploadAsync(m_HostSkipIfFolded.Data(), n, m_SkipIfFoldedDevice);
-    m_SideSeeds = UploadAsync(m_HostSideSeeds.Data(), 2 * n, m_SideSeedsDevice);
+    m_SideSeeds = UploadAsync(h.sideSeeds.Data(), 2 * n, m_SideSeedsDevice);
     return true;
   }
 
@@ -538,7 +633,7 @@ private:
    *  than they overlapped (H100, paper configuration: 192.9 s against
    *  184.2 s for 500 generations). */
   void
-  LaunchFoldChecks(std::size_t candidates)
+  LaunchFoldChecks(std::size_t candidates, HostCandidates & h)
   {
     cudaStream_t stream = m_Stream->Get();
     m_Outcome.Reserve(2 * candidates);
@@ -554,13 +649,13 @@ private:
     Check(cudaMemcpyAsync(m_HostOutcome.Data(), m_Outcome.Data(), 2 * candidates, cudaMemcpyDeviceToHost, copies),
           "copying fold checks from the device");
     if (m_Folds.repair)
-      Check(cudaMemcpyAsync(m_HostMoved.Data(), m_Moved.Data(), m_MovedCount * sizeof(double),
+      Check(cudaMemcpyAsync(h.moved.Data(), m_Moved.Data(), m_MovedCount * sizeof(double),
                             cudaMemcpyDeviceToHost, copies),
             "copying repaired points from the device");
   }
 
   void
-  ReadFoldChecks(const std::vector<PartialCandidate> & candidates)
+  ReadFoldChecks(const std::vector<PartialCandidate> & candidates, const HostCandidates & h)
   {
     m_Statistics.foldSeconds += ElapsedSeconds(*m_FoldStart, *m_FoldEnd);
     for (std::size_t i = 0; i < candidates.size(); ++i)
@@ -579,7 +674,7 @@ private:
         if (!m_Folds.repair)
           continue;
         Vec3 *         out = side == 0 ? c.source : c.target;
-        const double * in = m_HostMoved.Data() + 6 * static_cast<std::size_t>(m_HostCandidateMoved[i]) + 3 * side;
+        const double * in = h.moved.Data() + 6 * static_cast<std::size_t>(h.candidateMoved[i]) + 3 * side;
         for (std::size_t k = 0; k < c.element->points.size(); ++k)
           for (int a = 0; a < 3; ++a)
             out[k][a] = in[6 * k + a];
@@ -894,9 +989,10 @@ private:
   cuda::DeviceArray<std::uint32_t> m_StagedParentSlots;
   cuda::PinnedArray<std::uint32_t> m_HostParentSlots;
   cuda::PinnedArray<std::uint32_t> m_HostElementPointOffsets, m_HostElementPoints, m_HostElementTetrahedronOffsets,
-    m_HostElementTetrahedra, m_HostCandidateElement, m_HostCandidateParent, m_HostCandidateMoved;
-  cuda::PinnedArray<std::uint64_t> m_HostFirstItem;
-  cuda::PinnedArray<double>        m_HostParents, m_HostMoved;
+    m_HostElementTetrahedra, m_HostCandidateSlot;
+  HostCandidates                   m_HostCandidates[2];
+  int                              m_CurrentHost{ 0 }; ///< the one of the batch in flight (or last)
+  cuda::PinnedArray<double>        m_HostParents;
   std::size_t                      m_MovedCount{ 0 };
   // Fold checks: the constraint once (SetFoldHandling), then per batch.
   cuda::FoldRepairConstants        m_Folds;
@@ -909,8 +1005,7 @@ private:
   cuda::DeviceArray<std::uint8_t>  m_FoldCheckDevice, m_SkipIfFoldedDevice, m_Outcome;
   cuda::DeviceArray<std::uint8_t>  m_ItemSkip; ///< per item of a batch: not sampled
   cuda::DeviceArray<std::uint64_t> m_SideSeedsDevice;
-  cuda::PinnedArray<std::uint8_t>  m_HostFoldCheck, m_HostSkipIfFolded, m_HostOutcome;
-  cuda::PinnedArray<std::uint64_t> m_HostSideSeeds;
+  cuda::PinnedArray<std::uint8_t>  m_HostSkipIfFolded, m_HostOutcome;
 };
 } // namespace
 
