@@ -159,6 +159,30 @@ TEST(ParetoFront, HypervolumeOfHandComputedSets)
   EXPECT_DOUBLE_EQ(morea::Hypervolume({ { { -1, -2, -3 } } }, { { 0, 0, 0 } }), 6.0);
 }
 
+TEST(ParetoFront, BoundedHypervolumeCountsFrontsBeyondItsScales)
+{
+  const ObjectiveVector scales{ { 2, 4, 8 } };
+  EXPECT_EQ(morea::BoundedHypervolume({}, scales), 0.0);
+  // f = s maps to 1/2 in every objective: (1 - 1/2)^3.
+  EXPECT_DOUBLE_EQ(morea::BoundedHypervolume({ { { 2, 4, 8 } } }, scales), 0.125);
+  // The origin dominates the whole unit cube.
+  EXPECT_DOUBLE_EQ(morea::BoundedHypervolume({ { { 0, 0, 0 } } }, scales), 1.0);
+  // f = 3 s maps to 3/4: a point far beyond the scales still counts, where a
+  // box at the scales would have left it out.
+  EXPECT_DOUBLE_EQ(morea::BoundedHypervolume({ { { 6, 4, 8 } } }, scales), 0.25 * 0.5 * 0.5);
+  EXPECT_EQ(morea::Hypervolume({ { { 6, 4, 8 } } }, scales), 0.0);
+  // Dominance is kept: a dominated point adds nothing, a better one adds.
+  const std::vector<ObjectiveVector> two{ { { 2, 4, 8 } }, { { 6, 1, 8 } } };
+  const double                       volume = morea::BoundedHypervolume(two, scales);
+  EXPECT_DOUBLE_EQ(volume, 0.125 + 0.25 * (0.8 - 0.5) * 0.5);
+  EXPECT_DOUBLE_EQ(morea::BoundedHypervolume({ two[0], two[1], { { 6, 4, 8 } } }, scales), volume);
+  EXPECT_GT(morea::BoundedHypervolume({ two[0], two[1], { { 1, 4, 8 } } }, scales), volume);
+  // Infinite objectives count for nothing; bad scales are an error.
+  EXPECT_EQ(morea::BoundedHypervolume({ { { 2, INFINITY, 8 } } }, scales), 0.0);
+  EXPECT_THROW(morea::BoundedHypervolume({}, { { 1, 0, 1 } }), morea::Error);
+  EXPECT_THROW(morea::BoundedHypervolume({}, { { 1, NAN, 1 } }), morea::Error);
+}
+
 TEST(ParetoFront, HypervolumeMatchesBruteForceOnRandomSets)
 {
   morea::RandomGenerator random(11);

@@ -66,7 +66,7 @@ struct GomeaOptions
 struct GenerationRecord
 {
   std::size_t generation{ 0 };
-  double      hypervolume{ 0.0 };  ///< of the archive, objectives divided by the reference point
+  double      hypervolume{ 0.0 };  ///< of the archive (BoundedHypervolume, scaled by the reference point)
   double      bestGuidance{ 0.0 }; ///< in the archive
   std::size_t archiveSize{ 0 };
   std::size_t feasible{ 0 };            ///< fold-free solutions in the population

@@ -65,6 +65,15 @@ NonDominatedRanks(const std::vector<Fitness> & population);
 double
 Hypervolume(const std::vector<ObjectiveVector> & points, const ObjectiveVector & reference);
 
+/** Hypervolume of `points` with each objective f mapped to f / (f + s), s
+ *  the objective's entry of `scales` (positive), against the reference
+ *  (1, 1, 1). The mapping keeps the order of every objective, hence
+ *  dominance, and takes [0, inf) into [0, 1): every front of nonnegative
+ *  objectives counts, however far it moves from where the scales were
+ *  taken, and fronts of one run compare as long as the scales stay. */
+double
+BoundedHypervolume(const std::vector<ObjectiveVector> & points, const ObjectiveVector & scales);
+
 /** Choosing one solution of a front (indices into `front`; all throw
  *  morea::Error on an empty front). Objectives are first normalised to [0,1]
  *  by the front's range (an objective with zero range counts as 0). */

@@ -363,8 +363,10 @@ MoRvGomea::Initialize(std::vector<DualMesh> population)
   m_SteeringLimit = std::numeric_limits<double>::infinity();
   EvaluatePopulationFully();
 
-  // The hypervolume reference: 1.1 times the worst initial feasible value, so
-  // later fronts are measured against a fixed box.
+  // The hypervolume's scales: 1.1 times the worst initial feasible value,
+  // fixed for the run so that generations compare (BoundedHypervolume: a
+  // front beyond them, such as the large deformations adaptive steering
+  // keeps, still counts).
   ObjectiveVector worst{ { 0.0, 0.0, 0.0 } };
   for (std::size_t s = 0; s < m_Population.size(); ++s)
   {
@@ -388,15 +390,12 @@ MoRvGomea::Summarise(std::size_t generation, GenerationRecord r) const
   r.bestGuidance = std::numeric_limits<double>::infinity();
   for (const auto & e : m_Archive->Entries())
   {
-    ObjectiveVector p;
-    for (std::size_t m = 0; m < NumberOfObjectives; ++m)
-      p[m] = e.fitness.objectives[m] / m_Reference[m];
-    points.push_back(p);
+    points.push_back(e.fitness.objectives);
     r.bestGuidance = std::min(r.bestGuidance, Value(e.fitness.objectives, Objective::Guidance));
   }
   if (points.empty())
     r.bestGuidance = 0.0;
-  r.hypervolume = Hypervolume(points, { { 1.0, 1.0, 1.0 } });
+  r.hypervolume = BoundedHypervolume(points, m_Reference);
   for (std::size_t s = 0; s < m_Population.size(); ++s)
     if (std::llround(m_Totals[s].sum.folded) == 0)
       ++r.feasible;

@@ -201,6 +201,27 @@ NonDominatedRanks(const std::vector<Fitness> & population)
 }
 
 double
+BoundedHypervolume(const std::vector<ObjectiveVector> & points, const ObjectiveVector & scales)
+{
+  for (double s : scales)
+    if (!(s > 0.0) || !std::isfinite(s))
+      throw Error("hypervolume: the scales must be positive and finite");
+  std::vector<ObjectiveVector> mapped;
+  mapped.reserve(points.size());
+  for (const ObjectiveVector & p : points)
+  {
+    ObjectiveVector q;
+    for (std::size_t m = 0; m < q.size(); ++m)
+    {
+      const double f = std::max(0.0, p[m]);
+      q[m] = std::isfinite(f) ? f / (f + scales[m]) : 1.0;
+    }
+    mapped.push_back(q);
+  }
+  return Hypervolume(mapped, { { 1.0, 1.0, 1.0 } });
+}
+
+double
 Hypervolume(const std::vector<ObjectiveVector> & points, const ObjectiveVector & reference)
 {
   // Sweep along the third objective: between consecutive z values the
