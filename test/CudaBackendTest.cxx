@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <numeric>
@@ -521,6 +522,92 @@ TEST(CudaEvaluationBackend, ParentsWithKeysAreKeptOnTheDevice)
   EXPECT_EQ(cuda->Statistics().parentsUploaded, 9u);
   for (std::size_t i = 0; i < first.size(); ++i)
     ExpectSameTotals(cpuChanged[i], batch.values[i], "candidate " + std::to_string(i), 1e-6);
+}
+
+TEST(CudaEvaluationBackend, CandidatesStartedEarlyGetTheValuesOfAWholeBatch)
+{
+  MOREA_REQUIRE_CUDA_DEVICE();
+  OptimiserTestProblem problem;
+  const auto           population = problem.InitialPopulation(problem.Options());
+  // Enough parents for batches of several parts (the backend splits batches
+  // of hundreds of thousands of tetrahedra), each parent with the elements of
+  // one group, parent after parent (as the optimiser orders them).
+  std::size_t itemsPerParent = 0;
+  for (std::size_t g = 0; g < 2; ++g)
+  {
+    std::size_t items = 0;
+    for (std::uint32_t e : problem.parallel.groups[g])
+      items += problem.parallel.elements[e].dependentTetrahedra.size();
+    itemsPerParent = g == 0 ? items : std::min(itemsPerParent, items);
+  }
+  ASSERT_GT(itemsPerParent, 0u);
+  std::vector<DualMesh> parents;
+  for (std::size_t i = 0; parents.size() * itemsPerParent < 450000; ++i)
+    parents.push_back(population[i % population.size()]);
+  morea_test::RandomCandidates first(problem, parents, problem.parallel.groups[0], 3.0, 41);
+  morea_test::RandomCandidates next(problem, parents, problem.parallel.groups[1], 3.0, 42);
+  morea_test::RandomCandidates whole(problem, parents, problem.parallel.groups[1], 3.0, 42);
+  const auto parentIndex = [&](const PartialCandidate & c) { return static_cast<std::size_t>(c.parent - parents.data()); };
+  for (auto * batch : { &first, &next, &whole })
+    for (PartialCandidate & c : batch->candidates)
+    {
+      c.parentKey = parentIndex(c) + 1;
+      c.evaluateFolded = parentIndex(c) % 3 != 0;
+    }
+  FoldHandling handling;
+  handling.constraint = problem.constraint.get();
+  handling.base = &problem.base;
+  handling.repair = true;
+  auto early = CreateCudaEvaluationBackend(*problem.evaluator, 2, CudaInterpolation::Texture);
+  auto late = CreateCudaEvaluationBackend(*problem.evaluator, 2, CudaInterpolation::Texture);
+  early->SetFoldHandling(handling);
+  late->SetFoldHandling(handling);
+  // While `first` is handed over, the candidates of `next` whose parents it
+  // has finished with start early.
+  std::size_t ranges = 0;
+  early->EvaluatePartials(
+    first.candidates,
+    [&](std::size_t, std::size_t end) {
+      ++ranges;
+      if (end == first.candidates.size())
+        return;
+      const std::size_t pending = parentIndex(first.candidates[end]);
+      std::size_t       head = 0;
+      while (head < next.candidates.size() && parentIndex(next.candidates[head]) < pending)
+        ++head;
+      early->StartNextPartials(next.candidates, head);
+    },
+    [&] { early->PrepareNextPartials(next.candidates); });
+  ASSERT_GE(ranges, 2u) << "the batch was not handed over in parts";
+  early->EvaluatePartials(next.candidates);
+  EXPECT_GT(early->Statistics().startedCandidates, 0u);
+  EXPECT_LT(early->Statistics().startedCandidates, next.candidates.size());
+  late->EvaluatePartials(whole.candidates);
+  EXPECT_EQ(late->Statistics().startedCandidates, 0u);
+  std::size_t folded = 0;
+  for (std::size_t i = 0; i < next.candidates.size(); ++i)
+  {
+    ASSERT_EQ(next.folds[i].foldedSides, whole.folds[i].foldedSides) << "candidate " << i;
+    ASSERT_EQ(next.folds[i].repairedSides, whole.folds[i].repairedSides) << "candidate " << i;
+    ASSERT_EQ(next.source[i], whole.source[i]) << "candidate " << i;
+    ASSERT_EQ(next.target[i], whole.target[i]) << "candidate " << i;
+    folded += next.folds[i].foldedSides;
+    if (next.folds[i].Folded() && !next.candidates[i].evaluateFolded)
+      continue; // not evaluated
+    for (std::size_t k = 0; k < next.values[i].size(); ++k)
+    {
+      ASSERT_EQ(next.values[i][k].intensity, whole.values[i][k].intensity) << "candidate " << i;
+      ASSERT_EQ(next.values[i][k].guidance, whole.values[i][k].guidance) << "candidate " << i;
+      ASSERT_EQ(next.values[i][k].samples, whole.values[i][k].samples) << "candidate " << i;
+    }
+  }
+  EXPECT_GT(folded, 100u);
+  // Outside the hand-over of a next-to-last part a start is ignored.
+  const std::uint64_t started = early->Statistics().startedCandidates;
+  early->PrepareNextPartials(whole.candidates);
+  early->StartNextPartials(whole.candidates, 10);
+  early->EvaluatePartials(whole.candidates);
+  EXPECT_EQ(early->Statistics().startedCandidates, started);
 }
 
 TEST(CudaEvaluationBackend, FoldChecksAndRepairAgreeWithTheCpu)

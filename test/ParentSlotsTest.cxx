@@ -2,6 +2,8 @@
 // of parents a batch does not name are reused, equal keys share a slot.
 #include "morea/ParentSlots.h"
 
+#include "morea/Error.h"
+
 #include <gtest/gtest.h>
 
 #include <set>
@@ -89,5 +91,31 @@ TEST(ParentSlots, GrowingLosesEverythingHeld)
   EXPECT_FALSE(c.grown);
   EXPECT_EQ(c.upload, (std::vector<std::size_t>{ 1 }));
   EXPECT_EQ(c.slot[0], b.slot[4]);
+}
+TEST(ParentSlots, ABatchAssignedInTwoCallsKeepsTheFirstCallsSlots)
+{
+  ParentSlots slots;
+  slots.Assign({ 11, 12, 13, 14 });
+  // Next batch: 11 and 15 now, room for 4 parents; 12 changed to 16 later.
+  const auto first = slots.AssignFirst({ 11, 15 }, 4);
+  EXPECT_FALSE(first.grown);
+  EXPECT_EQ(first.upload, (std::vector<std::size_t>{ 1 }));
+  const auto rest = slots.AssignRest({ 16, 13, 15 });
+  EXPECT_FALSE(rest.grown);
+  // 15 keeps the first call's slot (no second upload); 16 takes a slot
+  // neither call named, not one of the first call's.
+  EXPECT_EQ(rest.upload, (std::vector<std::size_t>{ 0 }));
+  EXPECT_EQ(rest.slot[2], first.slot[1]);
+  std::set<std::uint32_t> used{ first.slot[0], first.slot[1], rest.slot[0], rest.slot[1] };
+  EXPECT_EQ(used.size(), 4u);
+  // The first call makes room for the whole batch: growing later would lose
+  // slots already uploaded.
+  const auto grown = slots.AssignFirst({ 11 }, 6);
+  EXPECT_TRUE(grown.grown);
+  EXPECT_GE(grown.capacity, 6u);
+  const auto more = slots.AssignRest({ 21, 22, 23, 24, 25 });
+  EXPECT_EQ(more.upload.size(), 5u);
+  EXPECT_THROW(slots.AssignRest({ 26 }), morea::Error);
+  EXPECT_THROW(ParentSlots().AssignRest({ 1 }), morea::Error);
 }
 } // namespace

@@ -86,6 +86,9 @@ struct BackendStatistics
   /** CUDA only: parents uploaded by EvaluatePartials (those whose key it
    *  did not hold, see PartialCandidate::parentKey). */
   std::uint64_t parentsUploaded{ 0 };
+  /** CUDA only: candidates evaluated after their upload and fold checks had
+   *  started early (StartNextPartials). */
+  std::uint64_t startedCandidates{ 0 };
   /** CUDA only: where the device time of the EvaluatePartials batches goes,
    *  between events on its stream. A phase in which the stream is empty
    *  counts the host's time: `betweenBatches` and `staging` are the device
@@ -179,6 +182,20 @@ public:
   PrepareNextPartials(const std::vector<PartialCandidate> & next)
   {
     static_cast<void>(next);
+  }
+
+  /** Lets the backend start on the first `head` candidates of the next
+   *  EvaluatePartials call (prepared with PrepareNextPartials) before the
+   *  current call returns, when the current batch's acceptance can no longer
+   *  change them: their parents' points, keys and `evaluateFolded` are
+   *  final. Heeded only from `ready` for the current call's next-to-last
+   *  range (the CUDA backend then checks their folds while the caller accepts
+   *  the last part); ignored otherwise and by default. */
+  virtual void
+  StartNextPartials(const std::vector<PartialCandidate> & next, std::size_t head)
+  {
+    static_cast<void>(next);
+    static_cast<void>(head);
   }
 
   /** Fold checks and repair of later EvaluatePartials calls; the constraint

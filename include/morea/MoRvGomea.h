@@ -213,7 +213,11 @@ private:
    *  order; returns how many were accepted. */
   std::size_t
   ProcessCandidates(CandidateBatch & batch, GenerationRecord & record,
-                    const EvaluationBackend::Meanwhile & meanwhile = {});
+                    const EvaluationBackend::Meanwhile & meanwhile = {}, CandidateBatch * next = nullptr);
+  /** Sets what acceptance decides (parent keys, whether a folded candidate
+   *  is evaluated) for candidates [begin, end) of `batch`'s partials. */
+  void
+  SetParentState(CandidateBatch & batch, std::size_t begin, std::size_t end) const;
   /** The acceptance step of ProcessCandidates for candidates [begin, end),
    *  which have their values; `changed` marks solutions changed since their
    *  verdicts were taken. */

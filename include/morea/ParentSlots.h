@@ -34,7 +34,21 @@ public:
   /** Slots for the parents of one batch, given their keys (0: kept for this
    *  batch only). A slot whose parent the batch does not name is reused. */
   Assignment
-  Assign(const std::vector<std::uint64_t> & keys);
+  Assign(const std::vector<std::uint64_t> & keys)
+  {
+    return AssignFirst(keys, 0);
+  }
+
+  /** Assign in two calls, for a batch whose later parents are not final
+   *  yet: the first parents now, with room for `total` parents in all (the
+   *  store grows here if it must); the others with AssignRest, which takes
+   *  none of the first call's slots and never grows the store (slots
+   *  uploaded after the first call stay valid). Throws morea::Error when
+   *  the batch has more parents than `total` allowed for. */
+  Assignment
+  AssignFirst(const std::vector<std::uint64_t> & keys, std::size_t total);
+  Assignment
+  AssignRest(const std::vector<std::uint64_t> & keys);
 
   std::size_t
   Capacity() const
@@ -43,6 +57,9 @@ public:
   }
 
 private:
+  void
+  Place(const std::vector<std::uint64_t> & keys, Assignment & out);
+
   std::unordered_map<std::uint64_t, std::uint32_t> m_SlotOfKey;
   std::vector<std::uint64_t>                       m_KeyOfSlot;   ///< 0: nothing kept
   std::vector<std::uint64_t>                       m_BatchOfSlot; ///< the last batch that used it

@@ -719,9 +719,22 @@ MoRvGomea::BuildPartials(CandidateBatch & candidateBatch) const
   candidateBatch.partialsBuilt = true;
 }
 
+void
+MoRvGomea::SetParentState(CandidateBatch & candidateBatch, std::size_t begin, std::size_t end) const
+{
+  m_Pool->ParallelFor(end - begin, [&](std::size_t k) {
+    const Candidate &  c = candidateBatch.candidates[begin + k];
+    PartialCandidate & p = candidateBatch.partials[begin + k];
+    // An id names one set of points (a change gets a new id, a donor's
+    // points keep the donor's), so the key lets the backend keep parents.
+    p.parentKey = std::max<std::uint64_t>(1, HashCombine(m_KeySalt, m_Ids[c.solution]));
+    p.evaluateFolded = std::llround(m_Totals[c.solution].sum.folded) != 0;
+  });
+}
+
 std::size_t
 MoRvGomea::ProcessCandidates(CandidateBatch & candidateBatch, GenerationRecord & record,
-                             const EvaluationBackend::Meanwhile & meanwhile)
+                             const EvaluationBackend::Meanwhile & meanwhile, CandidateBatch * next)
 {
   std::vector<Candidate> & candidates = candidateBatch.candidates;
   // 1. Fold checks (and repair) and evaluation of the whole batch at once,
@@ -735,14 +748,7 @@ MoRvGomea::ProcessCandidates(CandidateBatch & candidateBatch, GenerationRecord &
   std::vector<PartialCandidate> &    batch = candidateBatch.partials;
   const std::vector<CandidateFolds> & folds = candidateBatch.folds;
   // In parallel: the device waits for this (a batch holds tens of thousands).
-  m_Pool->ParallelFor(candidates.size(), [&](std::size_t i) {
-    const Candidate &  c = candidates[i];
-    PartialCandidate & p = batch[i];
-    // An id names one set of points (a change gets a new id, a donor's
-    // points keep the donor's), so the key lets the backend keep parents.
-    p.parentKey = std::max<std::uint64_t>(1, HashCombine(m_KeySalt, m_Ids[c.solution]));
-    p.evaluateFolded = std::llround(m_Totals[c.solution].sum.folded) != 0;
-  });
+  SetParentState(candidateBatch, 0, candidates.size());
   // 2. Acceptance of each part of the batch as the backend hands it over
   //    (in order), while the device may still compute the next part.
   std::vector<bool> changed(m_Population.size(), false);
@@ -751,6 +757,20 @@ MoRvGomea::ProcessCandidates(CandidateBatch & candidateBatch, GenerationRecord &
   const auto        accept = [&](std::size_t begin, std::size_t end) {
     const auto phaseStart = std::chrono::steady_clock::now();
     accepted += AcceptCandidates(candidateBatch, batch, folds, begin, end, changed, record);
+    // The next batch's candidates of solutions this batch has finished with
+    // (a prefix: both batches take the solutions in one order) are final:
+    // the backend may start on them while the rest is handed over.
+    if (next && next->partialsBuilt && end < candidates.size())
+    {
+      std::vector<bool> pending(m_Population.size(), false);
+      for (std::size_t i = end; i < candidates.size(); ++i)
+        pending[candidates[i].solution] = true;
+      std::size_t head = 0;
+      while (head < next->candidates.size() && !pending[next->candidates[head].solution])
+        ++head;
+      SetParentState(*next, 0, head);
+      m_Backend.StartNextPartials(next->partials, head);
+    }
     acceptanceSeconds += SecondsSince(phaseStart);
   };
   const BackendStatistics before = m_Backend.Statistics();
@@ -1043,7 +1063,7 @@ MoRvGomea::RunGeneration()
         m_Backend.PrepareNextPartials(m_NextBatch->partials);
         record.phaseSeconds.evaluation += SecondsSince(staging);
       };
-    ProcessCandidates(batch, record, drawNext);
+    ProcessCandidates(batch, record, drawNext, i + 1 < groupOrder.size() ? m_NextBatch.get() : nullptr);
     for (const Candidate & cand : batch.candidates)
       if (cand.accepted)
       {

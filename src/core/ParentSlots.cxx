@@ -1,16 +1,17 @@
 #include "morea/ParentSlots.h"
 
+#include "morea/Error.h"
+
 #include <algorithm>
 #include <unordered_set>
 
 namespace morea
 {
 ParentSlots::Assignment
-ParentSlots::Assign(const std::vector<std::uint64_t> & keys)
+ParentSlots::AssignFirst(const std::vector<std::uint64_t> & keys, std::size_t total)
 {
   ++m_Batch;
   Assignment out;
-  out.slot.assign(keys.size(), 0);
   // Slots the batch needs: one per distinct nonzero key, one per key 0.
   std::size_t needed = 0;
   {
@@ -19,6 +20,7 @@ ParentSlots::Assign(const std::vector<std::uint64_t> & keys)
       if (k == 0 || seen.insert(k).second)
         ++needed;
   }
+  needed = std::max(needed, total);
   if (needed > m_KeyOfSlot.size())
   {
     // A larger store starts empty (the device copy does not survive).
@@ -28,6 +30,24 @@ ParentSlots::Assign(const std::vector<std::uint64_t> & keys)
     m_BatchOfSlot.assign(capacity, 0);
     out.grown = true;
   }
+  Place(keys, out);
+  return out;
+}
+
+ParentSlots::Assignment
+ParentSlots::AssignRest(const std::vector<std::uint64_t> & keys)
+{
+  if (m_Batch == 0)
+    throw Error("parent slots: AssignRest needs an AssignFirst before it");
+  Assignment out;
+  Place(keys, out);
+  return out;
+}
+
+void
+ParentSlots::Place(const std::vector<std::uint64_t> & keys, Assignment & out)
+{
+  out.slot.assign(keys.size(), 0);
   out.capacity = m_KeyOfSlot.size();
   // Parents already held keep their slots; those are taken first.
   std::vector<bool> held(keys.size(), false);
@@ -58,8 +78,10 @@ ParentSlots::Assign(const std::vector<std::uint64_t> & keys)
         continue;
       }
     }
-    while (m_BatchOfSlot[next] == m_Batch)
+    while (next < m_BatchOfSlot.size() && m_BatchOfSlot[next] == m_Batch)
       ++next;
+    if (next == m_BatchOfSlot.size())
+      throw Error("parent slots: the batch has more parents than its first part allowed for");
     const auto slot = static_cast<std::uint32_t>(next);
     if (m_KeyOfSlot[slot] != 0)
       m_SlotOfKey.erase(m_KeyOfSlot[slot]);
@@ -70,6 +92,5 @@ ParentSlots::Assign(const std::vector<std::uint64_t> & keys)
     out.slot[i] = slot;
     out.upload.push_back(i);
   }
-  return out;
 }
 } // namespace morea

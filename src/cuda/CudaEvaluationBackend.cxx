@@ -128,6 +128,9 @@ public:
     m_BatchEnd = std::make_unique<cuda::Event>();
     m_PreviousBatchEnd = std::make_unique<cuda::Event>();
     m_Staged = std::make_unique<cuda::Event>();
+    m_NextBatchStart = std::make_unique<cuda::Event>();
+    m_NextStaged = std::make_unique<cuda::Event>();
+    m_NextFoldStart = std::make_unique<cuda::Event>();
     m_HostChunks.Reserve(1);
     cuda::UploadSobolDirections(SobolDirectionNumbers());
 
@@ -248,19 +251,44 @@ public:
   EvaluatePartials(const std::vector<PartialCandidate> & candidates, const ReadyCandidates & ready,
                    const Meanwhile & meanwhile) override
   {
-    const auto  start = std::chrono::steady_clock::now();
-    Check(cudaEventRecord(m_BatchStart->Get(), m_Stream->Get()), "recording an event");
+    const auto       start = std::chrono::steady_clock::now();
     HostCandidates & host = m_HostCandidates[1 - m_CurrentHost];
-    if (!host.PackedFor(candidates))
-      PackCandidates(candidates, host);
+    const std::size_t n = candidates.size();
+    // Its first candidates may be on the device already (StartNextPartials).
+    const bool started = m_Head.open && host.PackedFor(candidates);
+    m_Head.open = false;
+    std::size_t head = 0;
+    bool        checks = false;
+    if (started)
+    {
+      head = m_Head.count;
+      checks = m_Head.checks;
+      std::swap(m_BatchStart, m_NextBatchStart);
+      std::swap(m_Staged, m_NextStaged);
+      std::swap(m_FoldStart, m_NextFoldStart);
+      CheckStartedHead(candidates, host, head);
+      m_Statistics.startedCandidates += head;
+    }
+    else
+    {
+      Check(cudaEventRecord(m_BatchStart->Get(), m_Stream->Get()), "recording an event");
+      if (!host.PackedFor(candidates))
+        PackCandidates(candidates, host);
+    }
     host.prepared = false;
     m_CurrentHost = 1 - m_CurrentHost;
-    const auto  items = UploadCandidates(candidates, host);
-    const bool  checks = items > 0 && StageFoldChecks(candidates, host);
+    const std::size_t items = host.firstItem[n];
+    if (items > 0)
+    {
+      if (!started)
+        checks = UploadTables(candidates, host, *m_Staged);
+      UploadRange(candidates, host, head, n, checks, *m_FoldStart);
+    }
+    else if (!started)
+      Check(cudaEventRecord(m_Staged->Get(), m_Stream->Get()), "recording an event");
+    Check(cudaEventRecord(m_FoldEnd->Get(), m_Stream->Get()), "recording an event");
     if (checks)
-      LaunchFoldChecks(candidates.size(), host);
-    else
-      Check(cudaEventRecord(m_FoldEnd->Get(), m_Stream->Get()), "recording an event");
+      CopyFoldChecksBack(n, host);
     if (items > 0)
     {
       Reserve(items);
@@ -335,6 +363,28 @@ public:
     HostCandidates & host = m_HostCandidates[1 - m_CurrentHost];
     PackCandidates(next, host);
     host.prepared = true;
+    m_Statistics.stagingSeconds += SecondsSince(start);
+  }
+
+  /** Uploads the first `head` candidates of the prepared next batch with
+   *  their parents and queues their fold checks behind the current batch's
+   *  last part, so that the device checks them while the caller accepts that
+   *  part (only while the next-to-last part is handed over). */
+  void
+  StartNextPartials(const std::vector<PartialCandidate> & next, std::size_t head) override
+  {
+    if (!m_AcceptHead || m_Head.open || head == 0 || head > next.size())
+      return;
+    HostCandidates & h = m_HostCandidates[1 - m_CurrentHost];
+    if (!h.PackedFor(next) || h.firstItem[next.size()] == 0 || h.largestChecked > cuda::MaxRepairElementPoints)
+      return;
+    const auto start = std::chrono::steady_clock::now();
+    Check(cudaEventRecord(m_NextBatchStart->Get(), m_Stream->Get()), "recording an event");
+    const bool checks = UploadTables(next, h, *m_NextStaged);
+    UploadRange(next, h, 0, head, checks, *m_NextFoldStart);
+    m_Head.open = true;
+    m_Head.count = head;
+    m_Head.checks = checks;
     m_Statistics.stagingSeconds += SecondsSince(start);
   }
 
@@ -538,46 +588,126 @@ private:
     });
   }
 
-  /** Uploads the packed batch and its parents (those the device does not
-   *  hold, see PartialCandidate::parentKey); returns the number of items. */
-  std::size_t
-  UploadCandidates(const std::vector<PartialCandidate> & candidates, HostCandidates & h)
+  /** Queues the upload of what is the same for every candidate range of a
+   *  packed batch (elements, candidate table, moved points, which
+   *  candidates are checked and their seeds), `staged` first; true when the
+   *  batch has fold checks. */
+  bool
+  UploadTables(const std::vector<PartialCandidate> & candidates, HostCandidates & h, cuda::Event & staged)
   {
     const std::size_t n = candidates.size();
-    const std::size_t items = h.firstItem[n];
-    if (items == 0)
-      return 0;
-    std::vector<std::uint64_t> parentKeys(h.parents.size());
-    for (std::size_t p = 0; p < h.parents.size(); ++p)
-      parentKeys[p] = candidates[h.parentFirstUse[p]].parentKey;
-    for (std::size_t i = 0; i < n; ++i)
-      if (candidates[i].parentKey != parentKeys[h.candidateParent[i]])
-        throw Error("evaluation backend: one parent with two keys in a batch");
-    const ParentSlots::Assignment slots = m_ParentSlots.Assign(parentKeys);
+    const bool        checks = m_FoldHandling.constraint && h.anyChecked;
+    if (checks && h.largestChecked > cuda::MaxRepairElementPoints)
+      throw Error("CUDA backend: fold checks handle elements of up to " + std::to_string(cuda::MaxRepairElementPoints) +
+                  " points, not " + std::to_string(h.largestChecked));
+    Check(cudaEventRecord(staged.Get(), m_Stream->Get()), "recording an event");
+    m_ParentKeys.assign(h.parents.size(), 0);
     m_HostCandidateSlot.Reserve(n);
-    for (std::size_t i = 0; i < n; ++i)
-      m_HostCandidateSlot[i] = slots.slot[h.candidateParent[i]];
-    Check(cudaEventRecord(m_Staged->Get(), m_Stream->Get()), "recording an event");
-    UploadParents(h.parents, slots);
+    m_CandidateParent.Reserve(n);
+    m_Batch.candidateParent = m_CandidateParent.Data();
     m_Batch.elementPointOffsets = StageAndUpload(h.pointOffsets, m_HostElementPointOffsets, m_ElementPointOffsets);
     m_Batch.elementPoints = StageAndUpload(h.points, m_HostElementPoints, m_ElementPoints);
     m_Batch.elementTetrahedronOffsets =
       StageAndUpload(h.tetrahedronOffsets, m_HostElementTetrahedronOffsets, m_ElementTetrahedronOffsets);
     m_Batch.elementTetrahedra = StageAndUpload(h.dependent, m_HostElementTetrahedra, m_ElementTetrahedra);
     m_Batch.candidateElement = UploadAsync(h.candidateElement.Data(), n, m_CandidateElement);
-    m_Batch.candidateParent = UploadAsync(m_HostCandidateSlot.Data(), n, m_CandidateParent);
     m_Batch.candidateMoved = UploadAsync(h.candidateMoved.Data(), n, m_CandidateMoved);
     m_Batch.candidateFirstItem = UploadAsync(h.firstItem.Data(), n + 1, m_FirstItem);
     m_Batch.moved = UploadAsync(h.moved.Data(), 6 * h.movedPoints, m_Moved);
     m_MovedCount = 6 * h.movedPoints;
     m_Batch.candidates = n;
-    return items;
+    if (checks)
+    {
+      m_FoldCheck = UploadAsync(h.foldCheck.Data(), n, m_FoldCheckDevice);
+      m_SideSeeds = UploadAsync(h.sideSeeds.Data(), 2 * n, m_SideSeedsDevice);
+      m_HostSkipIfFolded.Reserve(n);
+      m_SkipIfFoldedDevice.Reserve(n);
+      m_SkipIfFolded = m_SkipIfFoldedDevice.Data();
+      m_Outcome.Reserve(2 * n);
+      m_HostOutcome.Reserve(2 * n);
+    }
+    return checks;
   }
+
+  /** Candidates [begin, end) of a batch whose tables are queued: the slots
+   *  of the parents they use first, those parents (the ones the device does
+   *  not hold, see PartialCandidate::parentKey), which of them need no values
+   *  when left folded, then their fold checks, `foldStart` before them. The
+   *  whole batch is one range, or a head [0, h) the first call and the rest
+   *  the second (the store's slots are assigned in two steps then). */
+  void
+  UploadRange(const std::vector<PartialCandidate> & candidates, HostCandidates & h, std::size_t begin,
+              std::size_t end, bool checks, cuda::Event & foldStart)
+  {
+    // Parents are numbered by first use: those first used in the range are
+    // consecutive.
+    const auto        firstUse = h.parentFirstUse.begin();
+    const std::size_t pBegin = static_cast<std::size_t>(std::lower_bound(firstUse, h.parentFirstUse.end(), begin) - firstUse);
+    const std::size_t pEnd = static_cast<std::size_t>(std::lower_bound(firstUse, h.parentFirstUse.end(), end) - firstUse);
+    std::vector<std::uint64_t> keys(pEnd - pBegin);
+    for (std::size_t p = pBegin; p < pEnd; ++p)
+      keys[p - pBegin] = m_ParentKeys[p] = candidates[h.parentFirstUse[p]].parentKey;
+    for (std::size_t i = begin; i < end; ++i)
+      if (candidates[i].parentKey != m_ParentKeys[h.candidateParent[i]])
+        throw Error("evaluation backend: one parent with two keys in a batch");
+    const ParentSlots::Assignment slots =
+      begin == 0 ? m_ParentSlots.AssignFirst(keys, h.parents.size()) : m_ParentSlots.AssignRest(keys);
+    m_ParentSlot.resize(h.parents.size());
+    for (std::size_t p = pBegin; p < pEnd; ++p)
+      m_ParentSlot[p] = slots.slot[p - pBegin];
+    for (std::size_t i = begin; i < end; ++i)
+      m_HostCandidateSlot[i] = m_ParentSlot[h.candidateParent[i]];
+    const std::vector<const DualMesh *> parents(h.parents.begin() + static_cast<std::ptrdiff_t>(pBegin),
+                                                h.parents.begin() + static_cast<std::ptrdiff_t>(pEnd));
+    UploadParents(parents, slots, m_ParentStaging[begin == 0 ? 0 : 1]);
+    cudaStream_t stream = m_Stream->Get();
+    Check(cudaMemcpyAsync(m_CandidateParent.Data() + begin, m_HostCandidateSlot.Data() + begin,
+                          (end - begin) * sizeof(std::uint32_t), cudaMemcpyHostToDevice, stream),
+          "copying a batch to the device");
+    Check(cudaEventRecord(foldStart.Get(), stream), "recording an event");
+    if (!checks)
+      return;
+    m_Pool.ParallelFor(end - begin, [&](std::size_t k) {
+      const PartialCandidate & c = candidates[begin + k];
+      m_HostSkipIfFolded[begin + k] = c.folds && !c.evaluateFolded ? 1 : 0;
+    });
+    Check(cudaMemcpyAsync(m_SkipIfFoldedDevice.Data() + begin, m_HostSkipIfFolded.Data() + begin, end - begin,
+                          cudaMemcpyHostToDevice, stream),
+          "copying a batch to the device");
+    cuda::LaunchCheckCandidateFolds(m_Batch, m_Folds, m_FoldCheck, m_SideSeeds, m_Moved.Data(), m_Outcome.Data(),
+                                    begin, end - begin, stream);
+  }
+
+  /** A started head must be what the call passes: the same parents' keys
+   *  and the same candidates needing no values when left folded. */
+  void
+  CheckStartedHead(const std::vector<PartialCandidate> & candidates, const HostCandidates & h, std::size_t head) const
+  {
+    for (std::size_t i = 0; i < head; ++i)
+    {
+      const PartialCandidate & c = candidates[i];
+      if (c.parentKey != m_ParentKeys[h.candidateParent[i]] ||
+          (m_Head.checks && m_HostSkipIfFolded[i] != (c.folds && !c.evaluateFolded ? 1 : 0)))
+        throw Error("evaluation backend: candidates started early changed before their evaluation");
+    }
+  }
+
+  /** Host and device buffers that stage parents for the parent store; one
+   *  per candidate range of a batch, so that a later range does not
+   *  overwrite what an earlier one's queued copy still reads. */
+  struct ParentStaging
+  {
+    cuda::PinnedArray<double>        host;
+    cuda::PinnedArray<std::uint32_t> hostSlots;
+    cuda::DeviceArray<double>        staged;
+    cuda::DeviceArray<std::uint32_t> stagedSlots;
+  };
 
   /** Stages the parents `slots` names for upload and scatters them into
    *  their slots of the device's parent store. */
   void
-  UploadParents(const std::vector<const DualMesh *> & parents, const ParentSlots::Assignment & slots)
+  UploadParents(const std::vector<const DualMesh *> & parents, const ParentSlots::Assignment & slots,
+                ParentStaging & staging)
   {
     const std::size_t perParent = 6 * static_cast<std::size_t>(m_Batch.points);
     if (slots.grown)
@@ -587,62 +717,32 @@ private:
     m_Statistics.parentsUploaded += count;
     if (count == 0)
       return;
-    m_HostParents.Reserve(count * perParent);
-    m_HostParentSlots.Reserve(count);
+    staging.host.Reserve(count * perParent);
+    staging.hostSlots.Reserve(count);
     m_Pool.ParallelFor(count, [&](std::size_t u) {
       const DualMesh * parent = parents[slots.upload[u]];
-      double *         out = m_HostParents.Data() + u * perParent;
+      double *         out = staging.host.Data() + u * perParent;
       for (const Vec3 & v : parent->source)
         out = std::copy(v.begin(), v.end(), out);
       for (const Vec3 & v : parent->target)
         out = std::copy(v.begin(), v.end(), out);
-      m_HostParentSlots[u] = slots.slot[slots.upload[u]];
+      staging.hostSlots[u] = slots.slot[slots.upload[u]];
     });
-    const double *        staged = UploadAsync(m_HostParents.Data(), count * perParent, m_StagedParents);
-    const std::uint32_t * slotsOnDevice = UploadAsync(m_HostParentSlots.Data(), count, m_StagedParentSlots);
+    const double *        staged = UploadAsync(staging.host.Data(), count * perParent, staging.staged);
+    const std::uint32_t * slotsOnDevice = UploadAsync(staging.hostSlots.Data(), count, staging.stagedSlots);
     cuda::LaunchScatterParents(staged, slotsOnDevice, count, perParent, m_Parents.Data(), m_Stream->Get());
   }
 
-  /** Uploads which candidates are checked, which of them need no values
-   *  when left folded, and their sides' seeds; false when no candidate of
-   *  the batch asks for a check. */
-  bool
-  StageFoldChecks(const std::vector<PartialCandidate> & candidates, const HostCandidates & h)
-  {
-    if (!m_FoldHandling.constraint || !h.anyChecked)
-      return false;
-    if (h.largestChecked > cuda::MaxRepairElementPoints)
-      throw Error("CUDA backend: fold checks handle elements of up to " + std::to_string(cuda::MaxRepairElementPoints) +
-                  " points, not " + std::to_string(h.largestChecked));
-    const std::size_t n = candidates.size();
-    m_HostSkipIfFolded.Reserve(n);
-    m_Pool.ParallelFor(n, [&](std::size_t i) {
-      const PartialCandidate & c = candidates[i];
-      m_HostSkipIfFolded[i] = c.folds && !c.evaluateFolded ? 1 : 0;
-    });
-    m_FoldCheck = UploadAsync(h.foldCheck.Data(), n, m_FoldCheckDevice);
-    m_SkipIfFolded = UploadAsync(m_HostSkipIfFolded.Data(), n, m_SkipIfFoldedDevice);
-    m_SideSeeds = UploadAsync(h.sideSeeds.Data(), 2 * n, m_SideSeedsDevice);
-    return true;
-  }
-
-  /** The fold kernel, then its outcome and the repaired points back to the
-   *  host (read when the first part is handed over). On
-   *  the sampling stream, before the corners: run part by part on a second
-   *  stream beside the sampling, the two kernels slowed each other down more
-   *  than they overlapped (H100, paper configuration: 192.9 s against
-   *  184.2 s for 500 generations). */
+  /** The fold checks' outcome and the repaired points back to the host,
+   *  after them (read when the first part is handed over). The checks run
+   *  on the sampling stream, before the corners: run part by part on a
+   *  second stream beside the sampling, the two kernels slowed each other
+   *  down more than they overlapped (H100, paper configuration: 192.9 s
+   *  against 184.2 s for 500 generations). */
   void
-  LaunchFoldChecks(std::size_t candidates, HostCandidates & h)
+  CopyFoldChecksBack(std::size_t candidates, HostCandidates & h)
   {
-    cudaStream_t stream = m_Stream->Get();
-    m_Outcome.Reserve(2 * candidates);
-    m_HostOutcome.Reserve(2 * candidates);
-    Check(cudaEventRecord(m_FoldStart->Get(), stream), "recording an event");
-    cuda::LaunchCheckCandidateFolds(m_Batch, m_Folds, m_FoldCheck, m_SideSeeds, m_Moved.Data(), m_Outcome.Data(),
-                                    stream);
-    Check(cudaEventRecord(m_FoldEnd->Get(), stream), "recording an event");
-    // Back on the copy stream, so that the corners need not wait for the
+    // On the copy stream, so that the corners need not wait for the
     // transfer; read after part 0's values, which follow on that stream.
     cudaStream_t copies = m_CopyStream->Get();
     Check(cudaStreamWaitEvent(copies, m_FoldEnd->Get(), 0), "ordering the fold checks' copy after them");
@@ -912,9 +1012,24 @@ private:
       const auto start = std::chrono::steady_clock::now();
       Check(cudaEventSynchronize(m_CopiedEvents[p]->Get()), "copying values from the device");
       m_Statistics.waitSeconds += SecondsSince(start);
-      done(p);
+      // The caller may start the next batch's head while handing over the
+      // next-to-last part: it runs behind the last one.
+      m_AcceptHead = p + 2 == parts;
+      try
+      {
+        done(p);
+      }
+      catch (...)
+      {
+        m_AcceptHead = false;
+        throw;
+      }
+      m_AcceptHead = false;
     }
-    Synchronize("evaluating tetrahedra");
+    // The batch's end, not the stream's: a started head may follow it.
+    const auto end = std::chrono::steady_clock::now();
+    Check(cudaEventSynchronize(m_BatchEnd->Get()), "evaluating tetrahedra");
+    m_Statistics.waitSeconds += SecondsSince(end);
     for (std::size_t p = 0; p < parts; ++p)
     {
       if (UsesTexturePath())
@@ -964,6 +1079,7 @@ private:
   std::unique_ptr<cuda::Event>  m_FoldStart, m_FoldEnd;
   std::unique_ptr<cuda::Event>  m_BatchStart, m_BatchEnd; ///< an EvaluatePartials batch on the device
   std::unique_ptr<cuda::Event>  m_Staged;           ///< recorded before the batch's first upload
+  std::unique_ptr<cuda::Event>  m_NextBatchStart, m_NextStaged, m_NextFoldStart; ///< of a started head
   std::unique_ptr<cuda::Event>  m_PreviousBatchEnd; ///< the last batch's end, if m_HasPreviousBatch
   bool                          m_HasPreviousBatch{ false };
   std::vector<std::unique_ptr<cuda::Event>> m_PartEvents;   ///< each part's kernels: start, end
@@ -985,14 +1101,23 @@ private:
   cuda::DeviceArray<std::uint64_t> m_FirstItem;
   ParentSlots                      m_ParentSlots;
   cuda::DeviceArray<double>        m_Parents; ///< the parent store: slots of m_ParentSlots
-  cuda::DeviceArray<double>        m_StagedParents, m_Moved;
-  cuda::DeviceArray<std::uint32_t> m_StagedParentSlots;
-  cuda::PinnedArray<std::uint32_t> m_HostParentSlots;
+  cuda::DeviceArray<double>        m_Moved;
+  ParentStaging                    m_ParentStaging[2]; ///< the batch's first range, the rest
+  std::vector<std::uint64_t>       m_ParentKeys;       ///< per parent of the batch on the device
+  std::vector<std::uint32_t>       m_ParentSlot;       ///< per parent of the batch on the device
+  /** The next batch's head, started while the current one is handed over. */
+  struct
+  {
+    bool        open{ false };
+    std::size_t count{ 0 };
+    bool        checks{ false };
+  } m_Head;
+  bool m_AcceptHead{ false }; ///< StartNextPartials may start a head now
   cuda::PinnedArray<std::uint32_t> m_HostElementPointOffsets, m_HostElementPoints, m_HostElementTetrahedronOffsets,
     m_HostElementTetrahedra, m_HostCandidateSlot;
   HostCandidates                   m_HostCandidates[2];
   int                              m_CurrentHost{ 0 }; ///< the one of the batch in flight (or last)
-  cuda::PinnedArray<double>        m_HostParents;
+
   std::size_t                      m_MovedCount{ 0 };
   // Fold checks: the constraint once (SetFoldHandling), then per batch.
   cuda::FoldRepairConstants        m_Folds;

@@ -429,14 +429,15 @@ RepairSide(const FoldRepairConstants & k, const SideView & s, const std::uint32_
 
 __global__ void
 CheckCandidateFolds(CandidateBatch b, FoldRepairConstants k, const std::uint8_t * check,
-                    const std::uint64_t * sideSeeds, double * moved, std::uint8_t * outcome)
+                    const std::uint64_t * sideSeeds, double * moved, std::uint8_t * outcome, std::size_t first,
+                    std::size_t count)
 {
   __shared__ PointStar stars[RepairThreads / 32];
   const std::size_t warp = (static_cast<std::size_t>(blockIdx.x) * blockDim.x + threadIdx.x) / 32;
   const unsigned    lane = threadIdx.x % 32;
-  if (warp >= 2 * b.candidates)
+  if (warp >= 2 * count)
     return; // whole warps only: the block size is a multiple of 32
-  const std::size_t c = warp / 2;
+  const std::size_t c = first + warp / 2;
   const int         side = static_cast<int>(warp % 2);
   if (!check[c])
     return;
@@ -466,14 +467,16 @@ CheckCandidateFolds(CandidateBatch b, FoldRepairConstants k, const std::uint8_t 
 void
 LaunchCheckCandidateFolds(const CandidateBatch & batch, const FoldRepairConstants & constants,
                           const std::uint8_t * check, const std::uint64_t * sideSeeds, double * moved,
-                          std::uint8_t * outcome, void * stream)
+                          std::uint8_t * outcome, std::size_t first, std::size_t count, void * stream)
 {
-  if (batch.candidates == 0)
+  if (count == 0)
     return;
-  const std::size_t threads = 2 * batch.candidates * 32;
+  if (first + count > batch.candidates)
+    throw Error("fold checks: candidates beyond the batch");
+  const std::size_t threads = 2 * count * 32;
   const unsigned    blocks = static_cast<unsigned>((threads + RepairThreads - 1) / RepairThreads);
-  CheckCandidateFolds<<<blocks, RepairThreads, 0, static_cast<cudaStream_t>(stream)>>>(batch, constants, check,
-                                                                                       sideSeeds, moved, outcome);
+  CheckCandidateFolds<<<blocks, RepairThreads, 0, static_cast<cudaStream_t>(stream)>>>(
+    batch, constants, check, sideSeeds, moved, outcome, first, count);
   Check(cudaGetLastError(), "launching the fold check kernel");
 }
 } // namespace morea::cuda

@@ -38,11 +38,11 @@ constexpr std::uint32_t MaxRepairElementPoints = 64;
  *  one warp per side, a point's trials spread over the lanes. `moved` (the
  *  batch's moved points) is rewritten in place; side s of candidate c draws
  *  its moves with seed sideSeeds[2 c + s] and reports in outcome[2 c + s].
- *  Asynchronous on `stream`. */
+ *  Candidates [first, first + count) only. Asynchronous on `stream`. */
 void
 LaunchCheckCandidateFolds(const CandidateBatch & batch, const FoldRepairConstants & constants,
                           const std::uint8_t * check, const std::uint64_t * sideSeeds, double * moved,
-                          std::uint8_t * outcome, void * stream);
+                          std::uint8_t * outcome, std::size_t first, std::size_t count, void * stream);
 } // namespace morea::cuda
 
 #endif
