@@ -282,7 +282,8 @@ public:
     {
       if (!started)
         checks = UploadTables(candidates, host, *m_Staged);
-      UploadRange(candidates, host, head, n, checks, *m_FoldStart);
+      // A started head's fold checks began the phase already.
+      UploadRange(candidates, host, head, n, checks, started ? nullptr : m_FoldStart.get());
     }
     else if (!started)
       Check(cudaEventRecord(m_Staged->Get(), m_Stream->Get()), "recording an event");
@@ -381,7 +382,7 @@ public:
     const auto start = std::chrono::steady_clock::now();
     Check(cudaEventRecord(m_NextBatchStart->Get(), m_Stream->Get()), "recording an event");
     const bool checks = UploadTables(next, h, *m_NextStaged);
-    UploadRange(next, h, 0, head, checks, *m_NextFoldStart);
+    UploadRange(next, h, 0, head, checks, m_NextFoldStart.get());
     m_Head.open = true;
     m_Head.count = head;
     m_Head.checks = checks;
@@ -632,12 +633,12 @@ private:
   /** Candidates [begin, end) of a batch whose tables are queued: the slots
    *  of the parents they use first, those parents (the ones the device does
    *  not hold, see PartialCandidate::parentKey), which of them need no values
-   *  when left folded, then their fold checks, `foldStart` before them. The
+   *  when left folded, then their fold checks, `foldStart` (if any) before them. The
    *  whole batch is one range, or a head [0, h) the first call and the rest
    *  the second (the store's slots are assigned in two steps then). */
   void
   UploadRange(const std::vector<PartialCandidate> & candidates, HostCandidates & h, std::size_t begin,
-              std::size_t end, bool checks, cuda::Event & foldStart)
+              std::size_t end, bool checks, cuda::Event * foldStart)
   {
     // Parents are numbered by first use: those first used in the range are
     // consecutive.
@@ -664,7 +665,8 @@ private:
     Check(cudaMemcpyAsync(m_CandidateParent.Data() + begin, m_HostCandidateSlot.Data() + begin,
                           (end - begin) * sizeof(std::uint32_t), cudaMemcpyHostToDevice, stream),
           "copying a batch to the device");
-    Check(cudaEventRecord(foldStart.Get(), stream), "recording an event");
+    if (foldStart)
+      Check(cudaEventRecord(foldStart->Get(), stream), "recording an event");
     if (!checks)
       return;
     m_Pool.ParallelFor(end - begin, [&](std::size_t k) {
