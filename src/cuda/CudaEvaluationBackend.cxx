@@ -109,6 +109,24 @@ struct HostCandidates
   cuda::PinnedArray<std::uint64_t> sideSeeds;               ///< per candidate side
 };
 
+/** Sets a flag for a scope, cleared however the scope is left. */
+class AcceptHeadScope
+{
+public:
+  AcceptHeadScope(bool & flag, bool value)
+    : m_Flag(flag)
+  {
+    m_Flag = value;
+  }
+  ~AcceptHeadScope() { m_Flag = false; }
+  AcceptHeadScope(const AcceptHeadScope &) = delete;
+  AcceptHeadScope &
+  operator=(const AcceptHeadScope &) = delete;
+
+private:
+  bool & m_Flag;
+};
+
 class CudaEvaluationBackend final : public EvaluationBackend
 {
 public:
@@ -1016,17 +1034,10 @@ private:
       m_Statistics.waitSeconds += SecondsSince(start);
       // The caller may start the next batch's head while handing over the
       // next-to-last part: it runs behind the last one.
-      m_AcceptHead = p + 2 == parts;
-      try
       {
+        const AcceptHeadScope scope(m_AcceptHead, p + 2 == parts);
         done(p);
       }
-      catch (...)
-      {
-        m_AcceptHead = false;
-        throw;
-      }
-      m_AcceptHead = false;
     }
     // The batch's end, not the stream's: a started head may follow it.
     const auto end = std::chrono::steady_clock::now();
