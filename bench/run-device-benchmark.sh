@@ -12,6 +12,8 @@
 #   Late generations in detail: `morea benchmark ... --from-checkpoint RUNDIR/checkpoint.bin`
 #                  times the generations after a register checkpoint; bench/device-phases.py
 #                  JSON prints where the device's time went (device_phase_seconds).
+#                  bench/run-device-benchmark.sh late OUTDIR SECONDS BACKEND [GENERATIONS]
+#                  does both on the GPU machine.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 DATA=${MOREA_DATA:-../shared/data/abdomen-cbct-pair}
@@ -105,9 +107,35 @@ case "${1:-}" in
       echo "$name: $(md5sum < "/tmp/ab/$name/front.csv" 2>/dev/null)"
     done
     ;;
+  late)
+    # Where late generations' time goes: the bundle's morea registers for
+    # SECONDS (85 reach generation ~330 on an H100), then `morea benchmark`
+    # times GENERATIONS more from that checkpoint; OUTDIR/late.json and the
+    # summary of its device phases (bench/device-phases.py).
+    out=${2:?output folder}
+    seconds=${3:?seconds of the start}
+    backend=${4:?backend}
+    generations=${5:-40}
+    mkdir -p "$out" /tmp/b /tmp/ab
+    [ -x /tmp/b/bin/morea ] || tar xJf device-carry/bundle.tar.xz -C /tmp/b
+    export LD_LIBRARY_PATH=/tmp/b/lib
+    rm -rf /tmp/ab/late
+    register /tmp/b/bin/morea /tmp/ab/late "$seconds" "$backend" || true
+    D=/tmp/b/data/abdomen
+    /tmp/b/bin/morea benchmark \
+      --fixed "$D/CB02.mha" --moving "$D/CB07.mha" \
+      --fixed-structure Stomach_duo_CBCT="$D/CB02_labels.mha:Stomach_duo_CBCT" \
+      --moving-structure Stomach_duo_CBCT="$D/CB07_masks/Stomach_duo_CBCT.mha" \
+      --fixed-structure Bowel_sm_CBCT="$D/CB02_labels.mha:Bowel_sm_CBCT" \
+      --moving-structure Bowel_sm_CBCT="$D/CB07_masks/Bowel_sm_CBCT.mha" \
+      --parameters bench/configurations/abdomen_paper.toml --backends "$backend" \
+      --from-checkpoint /tmp/ab/late/checkpoint.bin --generations "$generations" --probe 0 \
+      -o "$out/late.json" > "$out/late.log" 2>&1
+    python3 bench/device-phases.py "$out/late.json" "$backend" | tee "$out/late-summary.txt"
+    ;;
   *)
     echo "usage: $0 bundle | run OUTDIR [morea benchmark options] | register OUTDIR RUNDIR [SECONDS [BACKEND]]" \
-      "| ab OUTDIR SECONDS BACKEND PROGRAM..." >&2
+      "| ab OUTDIR SECONDS BACKEND PROGRAM... | late OUTDIR SECONDS BACKEND [GENERATIONS]" >&2
     exit 2
     ;;
 esac
