@@ -18,19 +18,22 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 DATA=${MOREA_DATA:-../shared/data/abdomen-cbct-pair}
 
+# The bundled pair (unpacked on the GPU machine) and the paper's
+# configuration, as morea options.
+D=/tmp/b/data/abdomen
+PROBLEM=(--fixed "$D/CB02.mha" --moving "$D/CB07.mha"
+  --fixed-structure Stomach_duo_CBCT="$D/CB02_labels.mha:Stomach_duo_CBCT"
+  --moving-structure Stomach_duo_CBCT="$D/CB07_masks/Stomach_duo_CBCT.mha"
+  --fixed-structure Bowel_sm_CBCT="$D/CB02_labels.mha:Bowel_sm_CBCT"
+  --moving-structure Bowel_sm_CBCT="$D/CB07_masks/Bowel_sm_CBCT.mha"
+  --parameters bench/configurations/abdomen_paper.toml)
+
 # register PROGRAM RUNDIR SECONDS BACKEND: `morea register` of the paper's
 # configuration on the bundled pair, resuming RUNDIR's checkpoint, stopped
 # (SIGKILL) after SECONDS; the log is appended to RUNDIR/register.log.
 register() {
-  local D=/tmp/b/data/abdomen
   mkdir -p "$2"
-  timeout --signal=KILL "$3" "$1" register \
-    --fixed "$D/CB02.mha" --moving "$D/CB07.mha" \
-    --fixed-structure Stomach_duo_CBCT="$D/CB02_labels.mha:Stomach_duo_CBCT" \
-    --moving-structure Stomach_duo_CBCT="$D/CB07_masks/Stomach_duo_CBCT.mha" \
-    --fixed-structure Bowel_sm_CBCT="$D/CB02_labels.mha:Bowel_sm_CBCT" \
-    --moving-structure Bowel_sm_CBCT="$D/CB07_masks/Bowel_sm_CBCT.mha" \
-    --parameters bench/configurations/abdomen_paper.toml --backend "$4" \
+  timeout --signal=KILL "$3" "$1" register "${PROBLEM[@]}" --backend "$4" \
     --checkpoint-every 10 --resume -o "$2" >> "$2/register.log" 2>&1
 }
 case "${1:-}" in
@@ -52,14 +55,7 @@ case "${1:-}" in
     export LD_LIBRARY_PATH=/tmp/b/lib
     nvidia-smi --query-gpu=name,memory.total,driver_version,clocks.max.sm --format=csv | tee "$out/gpu.txt"
     /tmp/b/bin/MOREACoreTests --gtest_filter='*Cuda*:*BackendSelection*' 2>&1 | tee "$out/agreement-tests.log" | tail -4 || true
-    D=/tmp/b/data/abdomen
-    /tmp/b/bin/morea benchmark \
-      --fixed "$D/CB02.mha" --moving "$D/CB07.mha" \
-      --fixed-structure Stomach_duo_CBCT="$D/CB02_labels.mha:Stomach_duo_CBCT" \
-      --moving-structure Stomach_duo_CBCT="$D/CB07_masks/Stomach_duo_CBCT.mha" \
-      --fixed-structure Bowel_sm_CBCT="$D/CB02_labels.mha:Bowel_sm_CBCT" \
-      --moving-structure Bowel_sm_CBCT="$D/CB07_masks/Bowel_sm_CBCT.mha" \
-      --parameters bench/configurations/abdomen_paper.toml -o "$out/benchmark.json" "$@" 2>&1 | tee "$out/benchmark.log"
+    /tmp/b/bin/morea benchmark "${PROBLEM[@]}" -o "$out/benchmark.json" "$@" 2>&1 | tee "$out/benchmark.log"
     ;;
   register)
     # The paper's configuration end to end with `morea register`, resumable:
@@ -121,14 +117,7 @@ case "${1:-}" in
     export LD_LIBRARY_PATH=/tmp/b/lib
     rm -rf /tmp/ab/late
     register /tmp/b/bin/morea /tmp/ab/late "$seconds" "$backend" || true
-    D=/tmp/b/data/abdomen
-    /tmp/b/bin/morea benchmark \
-      --fixed "$D/CB02.mha" --moving "$D/CB07.mha" \
-      --fixed-structure Stomach_duo_CBCT="$D/CB02_labels.mha:Stomach_duo_CBCT" \
-      --moving-structure Stomach_duo_CBCT="$D/CB07_masks/Stomach_duo_CBCT.mha" \
-      --fixed-structure Bowel_sm_CBCT="$D/CB02_labels.mha:Bowel_sm_CBCT" \
-      --moving-structure Bowel_sm_CBCT="$D/CB07_masks/Bowel_sm_CBCT.mha" \
-      --parameters bench/configurations/abdomen_paper.toml --backends "$backend" \
+    /tmp/b/bin/morea benchmark "${PROBLEM[@]}" --backends "$backend" \
       --from-checkpoint /tmp/ab/late/checkpoint.bin --generations "$generations" --probe 0 \
       -o "$out/late.json" > "$out/late.log" 2>&1
     python3 bench/device-phases.py "$out/late.json" "$backend" | tee "$out/late-summary.txt"

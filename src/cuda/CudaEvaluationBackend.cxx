@@ -303,7 +303,7 @@ public:
       // A started head's fold checks began the phase already.
       UploadRange(candidates, host, head, n, checks, started ? nullptr : m_FoldStart.get());
     }
-    else if (!started)
+    else // (a started head has items)
       Check(cudaEventRecord(m_Staged->Get(), m_Stream->Get()), "recording an event");
     Check(cudaEventRecord(m_FoldEnd->Get(), m_Stream->Get()), "recording an event");
     if (checks)
