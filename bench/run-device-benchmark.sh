@@ -122,9 +122,37 @@ case "${1:-}" in
       -o "$out/late.json" > "$out/late.log" 2>&1
     python3 bench/device-phases.py "$out/late.json" "$backend" | tee "$out/late-summary.txt"
     ;;
+  early)
+    # Early generations of several programs, in turns (ROUNDS times each):
+    # `morea benchmark` of GENERATIONS from scratch; per program and round
+    # OUTDIR/NAME-ROUND.json, and one line each of kernel samples per second
+    # and seconds per generation.
+    out=${2:?output folder}
+    generations=${3:?generations}
+    rounds=${4:?rounds}
+    backend=${5:?backend}
+    shift 5
+    mkdir -p "$out" /tmp/b
+    [ -x /tmp/b/bin/morea ] || tar xJf device-carry/bundle.tar.xz -C /tmp/b
+    export LD_LIBRARY_PATH=/tmp/b/lib
+    for round in $(seq "$rounds"); do
+      for program in "$@"; do
+        name=$(basename "$program")
+        "$program" benchmark "${PROBLEM[@]}" --backends "$backend" --generations "$generations" --probe 0 \
+          -o "$out/$name-$round.json" > "$out/$name-$round.log" 2>&1 || { tail -3 "$out/$name-$round.log"; continue; }
+        python3 - "$out/$name-$round.json" "$backend" "$name" <<'EOF'
+import json, sys
+run = json.load(open(sys.argv[1]))["runs"][sys.argv[2]]
+print(f"{sys.argv[3]}: {run['samples_per_second_kernel']:.4e} samples/s in kernels, "
+      f"{run['seconds_per_generation']:.4f} s per generation, {run['seconds_in_kernels']:.3f} s in kernels")
+EOF
+      done
+    done
+    ;;
   *)
     echo "usage: $0 bundle | run OUTDIR [morea benchmark options] | register OUTDIR RUNDIR [SECONDS [BACKEND]]" \
-      "| ab OUTDIR SECONDS BACKEND PROGRAM... | late OUTDIR SECONDS BACKEND [GENERATIONS]" >&2
+      "| ab OUTDIR SECONDS BACKEND PROGRAM... | late OUTDIR SECONDS BACKEND [GENERATIONS]" \
+      "| early OUTDIR GENERATIONS ROUNDS BACKEND PROGRAM..." >&2
     exit 2
     ;;
 esac
