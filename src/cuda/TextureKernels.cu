@@ -408,7 +408,13 @@ SampleRows(const SamplingConstants & k, const float4 * corners, std::uint32_t j,
  *    before fetching them (each warp instruction then covers a compact part
  *    of the tetrahedron; L1 hit rate 81 -> 84 %): 0.35 s against 0.28 s, the
  *    sort's instructions cost more than the fetches saved;
- *  - two samples per lane in flight: 0.286-0.290 s against 0.265 s. */
+ *  - two samples per lane in flight: 0.286-0.290 s against 0.265 s;
+ *  - the mapped image read through the load path instead (per voxel its
+ *    2 x 2 x 2 texels as one 16-byte brick, software trilinear), since the
+ *    texture units' data pipe is the limit (81 % busy, the load path 27 %):
+ *    8.09e10 samples per second when tasks of at most 1024 samples used it,
+ *    7.06e10 when all did, against 8.33e10; the bricks' eightfold footprint
+ *    costs more in L1 than the second pipe gains. */
 __device__ void
 SampleChunk(const SamplingConstants & k, const SampleTask * __restrict__ tasks,
             const std::uint32_t * __restrict__ taskFirstChunk, const std::uint32_t * __restrict__ chunkTask,
