@@ -219,12 +219,17 @@ private:
   void
   SetParentState(CandidateBatch & batch, std::size_t begin, std::size_t end) const;
   /** The acceptance step of ProcessCandidates for candidates [begin, end),
-   *  which have their values; `changed` marks solutions changed since their
-   *  verdicts were taken. */
+   *  which have their values. */
   std::size_t
   AcceptCandidates(CandidateBatch & candidateBatch, const std::vector<PartialCandidate> & batch,
                    const std::vector<CandidateFolds> & folds, std::size_t begin, std::size_t end,
-                   std::vector<bool> & changed, GenerationRecord & record);
+                   GenerationRecord & record);
+  /** Whether candidate `c` (fitness `next`) replaces its parent (fitness
+   *  `now`): by its rule, or for Pareto candidates by constrained dominance
+   *  or the archive's acceptance (brought up to date from `verdict`; no
+   *  archive without one). */
+  bool
+  Accepted(const Candidate & c, const Fitness & next, const Fitness & now, ArchiveVerdict * verdict) const;
   void
   ForcedImprovement(std::size_t solution, int singleObjective, RandomGenerator & random, GenerationRecord & record);
   bool

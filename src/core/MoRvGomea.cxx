@@ -185,6 +185,32 @@ struct MoRvGomea::CandidateBatch
   std::vector<PartialCandidate> partials;
   std::vector<CandidateFolds>   folds;
   bool                          partialsBuilt{ false };
+  /** AcceptCandidates' per-candidate working storage (see there). */
+  struct Judged
+  {
+    std::vector<TetrahedronValues> changes;
+    std::vector<ArchiveVerdict>    verdicts;
+    std::vector<Fitness>           next, now;
+    std::vector<std::uint32_t>     solution;
+    std::vector<std::uint8_t>      guess; ///< the parallel pass's guess (refused for good, rejected, accepted)
+    std::vector<std::size_t>       order, chainStart;
+
+    void
+    Reserve(std::size_t count, std::size_t population)
+    {
+      if (changes.size() < count)
+      {
+        changes.resize(count);
+        verdicts.resize(count);
+        next.resize(count);
+        now.resize(count);
+        solution.resize(count);
+        guess.resize(count);
+        order.resize(count);
+      }
+      chainStart.assign(population + 1, 0);
+    }
+  } judged;
 
   /** Places each candidate's data; storage only grows. */
   void
@@ -751,12 +777,11 @@ MoRvGomea::ProcessCandidates(CandidateBatch & candidateBatch, GenerationRecord &
   SetParentState(candidateBatch, 0, candidates.size());
   // 2. Acceptance of each part of the batch as the backend hands it over
   //    (in order), while the device may still compute the next part.
-  std::vector<bool> changed(m_Population.size(), false);
   std::size_t       accepted = 0;
   double            acceptanceSeconds = 0.0;
   const auto        accept = [&](std::size_t begin, std::size_t end) {
     const auto phaseStart = std::chrono::steady_clock::now();
-    accepted += AcceptCandidates(candidateBatch, batch, folds, begin, end, changed, record);
+    accepted += AcceptCandidates(candidateBatch, batch, folds, begin, end, record);
     // The next batch's candidates of solutions this batch has finished with
     // (a prefix: both batches take the solutions in one order) are final:
     // the backend may start on them while the rest is handed over.
@@ -794,7 +819,7 @@ MoRvGomea::ProcessCandidates(CandidateBatch & candidateBatch, GenerationRecord &
 std::size_t
 MoRvGomea::AcceptCandidates(CandidateBatch & candidateBatch, const std::vector<PartialCandidate> & batch,
                             const std::vector<CandidateFolds> & folds, std::size_t begin, std::size_t end,
-                            std::vector<bool> & changed, GenerationRecord & record)
+                            GenerationRecord & record)
 {
   std::vector<Candidate> & candidates = candidateBatch.candidates;
   std::vector<std::size_t> batchIndex;
@@ -810,26 +835,57 @@ MoRvGomea::AcceptCandidates(CandidateBatch & candidateBatch, const std::vector<P
     record.tetrahedronEvaluations += static_cast<double>(m_Parallel.elements[c.element].dependentTetrahedra.size());
   }
 
-  // 3. Acceptance in a fixed order; candidates of one solution touch disjoint
+  // 3. Acceptance in a fixed order. Candidates of one solution touch disjoint
   //    tetrahedra, so each one's change of the totals does not depend on the
-  //    others and is summed in parallel first (reading the stored values is
-  //    bound by memory latency); each then sees the totals left by the ones
-  //    before it. The archive's scans are done in parallel too, as verdicts
-  //    on each candidate as if it came first: the ordered pass brings them up
-  //    to date cheaply (ElitistArchive::Accepts(f, verdict)), except for a
-  //    solution changed by an earlier candidate (the verdict is on other totals).
-  //    Runs of neighbouring candidates (mostly of one solution) are judged in
-  //    turn, each trying first the entry that refused the one before.
-  constexpr std::size_t          Run = 16;
-  std::vector<TetrahedronValues> changes(batchIndex.size());
-  std::vector<ArchiveVerdict>    verdicts(batchIndex.size());
-  m_Pool->ParallelFor((batchIndex.size() + Run - 1) / Run, [&](std::size_t r) {
-    std::uint64_t witness{ 0 };
-    for (std::size_t b = r * Run; b < std::min(batchIndex.size(), (r + 1) * Run); ++b)
+  //    others. Everything but the archive's changes is worked out in
+  //    parallel first, one solution's candidates in order as a chain, as if
+  //    the archive stayed as it is: the totals each candidate sees after the
+  //    ones before it (those the chain accepts), its fitness and its
+  //    parent's, and the archive's verdict on it (ElitistArchive::Judge; runs
+  //    of a chain try first the entry that refused the one before). The
+  //    ordered pass then only brings the verdicts up to date
+  //    (ElitistArchive::Accepts(f, verdict) looks at newer entries only),
+  //    passes over those refused for good, and applies the acceptances. Late
+  //    in a paper-scale run on 16 cores this halved the ordered pass (about
+  //    0.033 to 0.017 s per generation). Where the archive's changes overturn a
+  //    chain's guess, the rest of that chain is judged afresh in the ordered
+  //    pass, as it would be without the chains: decisions and sums are those
+  //    of a plain ordered pass.
+  const std::size_t count = batchIndex.size();
+  auto &            j = candidateBatch.judged;
+  j.Reserve(count, m_Population.size());
+  // The guesses: rejected for good (infeasible, dominated by or equal to an
+  // entry) unless the archive is thinned meanwhile; rejected; accepted.
+  enum class Guess : std::uint8_t
+  {
+    Refused,
+    Rejected,
+    Accepted
+  };
+  // The chains: batch positions grouped by solution, in order.
+  for (std::size_t b = 0; b < count; ++b)
+  {
+    j.solution[b] = static_cast<std::uint32_t>(candidates[batchIndex[b]].solution);
+    ++j.chainStart[j.solution[b] + 1];
+  }
+  std::partial_sum(j.chainStart.begin(), j.chainStart.end(), j.chainStart.begin());
+  {
+    std::vector<std::size_t> fill(j.chainStart.begin(), j.chainStart.end() - 1);
+    for (std::size_t b = 0; b < count; ++b)
+      j.order[fill[j.solution[b]]++] = b;
+  }
+  m_Pool->ParallelFor(m_Population.size(), [&](std::size_t s) {
+    if (j.chainStart[s] == j.chainStart[s + 1])
+      return;
+    std::uint64_t   witness{ 0 };
+    ObjectiveTotals held = m_Totals[s]; // the chain's totals so far
+    Fitness         now = CurrentFitness(s);
+    for (std::size_t o = j.chainStart[s]; o < j.chainStart[s + 1]; ++o)
     {
+      const std::size_t  b = j.order[o];
       const Candidate &  c = candidates[batchIndex[b]];
       const FosElement & element = m_Parallel.elements[c.element];
-      const auto &              stored = m_TetValues[c.solution];
+      const auto &              stored = m_TetValues[s];
       const TetrahedronValues * values = candidateBatch.Values(c);
       ObjectiveTotals           change;
       for (std::size_t k = 0; k < element.dependentTetrahedra.size(); ++k)
@@ -837,45 +893,65 @@ MoRvGomea::AcceptCandidates(CandidateBatch & candidateBatch, const std::vector<P
         change.Add(stored[element.dependentTetrahedra[k]], -1.0);
         change.Add(values[k]);
       }
-      changes[b] = change.sum;
-      ObjectiveTotals totals = m_Totals[c.solution];
-      totals.Add(changes[b]);
-      verdicts[b] = m_Archive->Judge(Steered(totals.ToFitness(m_Topology.NumberOfTetrahedra())), witness);
-      witness = verdicts[b].witness;
+      j.changes[b] = change.sum;
+      ObjectiveTotals totals = held;
+      totals.Add(j.changes[b]);
+      const Fitness next = Steered(totals.ToFitness(m_Topology.NumberOfTetrahedra()));
+      j.next[b] = next;
+      j.now[b] = now;
+      j.verdicts[b] = ArchiveVerdict{};
+      bool accept = false;
+      if (c.forced || c.singleObjective >= 0)
+        accept = Accepted(c, next, now, nullptr);
+      else
+      {
+        j.verdicts[b] = m_Archive->Judge(next, witness);
+        witness = j.verdicts[b].witness;
+        accept = ConstraintDominates(next, now) || j.verdicts[b].kind == ArchiveVerdict::Kind::Accepted;
+      }
+      const Guess guess = accept ? Guess::Accepted
+                                 : (j.verdicts[b].kind == ArchiveVerdict::Kind::Rejected ? Guess::Refused
+                                                                                         : Guess::Rejected);
+      j.guess[b] = static_cast<std::uint8_t>(guess);
+      if (accept)
+      {
+        held = totals;
+        now = next;
+      }
     }
   });
-  // Verdicts are taken after the earlier parts' acceptances: only changes
-  // within this part make them stale.
-  for (std::size_t b = 0; b < batchIndex.size(); ++b)
-    changed[candidates[batchIndex[b]].solution] = false;
-  std::size_t accepted = 0;
-  for (std::size_t b = 0; b < batchIndex.size(); ++b)
+  // Chains whose guess the ordered pass overturned; their later candidates
+  // are judged on the totals the solution then has.
+  std::vector<bool>   overturned(m_Population.size(), false);
+  const std::uint64_t revision = m_Archive->ThinningRevision();
+  std::size_t         accepted = 0;
+  for (std::size_t b = 0; b < count; ++b)
   {
+    // Most candidates are refused for good: skipped without a look at them
+    // while their chain holds and the archive is not thinned.
+    const std::size_t s = j.solution[b];
+    const auto guess = static_cast<Guess>(j.guess[b]);
+    if (guess == Guess::Refused && !overturned[s] && m_Archive->ThinningRevision() == revision)
+      continue;
     Candidate &        c = candidates[batchIndex[b]];
     const FosElement & element = m_Parallel.elements[c.element];
-    const std::size_t  s = c.solution;
     ObjectiveTotals    totals = m_Totals[s];
-    totals.Add(changes[b]);
-    const Fitness    now = CurrentFitness(s);
-    const Fitness    next = Steered(totals.ToFitness(m_Topology.NumberOfTetrahedra()));
-    ArchiveVerdict & verdict = verdicts[b];
-    bool             accept = false;
-    if (changed[s]) // the verdict is on other totals: its witness is only a hint now
-      verdict.kind = ArchiveVerdict::Kind::Unknown;
-    if (c.forced)
-      accept = ConstraintDominates(next, now);
-    else if (c.singleObjective >= 0)
+    totals.Add(j.changes[b]);
+    ArchiveVerdict & verdict = j.verdicts[b];
+    const Fitness *  now = &j.now[b];
+    const Fitness *  next = &j.next[b];
+    Fitness          current, fresh;
+    if (overturned[s])
     {
-      const auto m = static_cast<std::size_t>(c.singleObjective);
-      if (next.feasible != now.feasible)
-        accept = next.feasible;
-      else if (!next.feasible)
-        accept = next.constraint < now.constraint;
-      else
-        accept = next.objectives[m] < now.objectives[m];
+      current = CurrentFitness(s);
+      fresh = Steered(totals.ToFitness(m_Topology.NumberOfTetrahedra()));
+      now = &current;
+      next = &fresh;
+      verdict.kind = ArchiveVerdict::Kind::Unknown; // on other totals: its witness is only a hint now
     }
-    else
-      accept = ConstraintDominates(next, now) || m_Archive->Accepts(next, verdict);
+    const bool accept = Accepted(c, *next, *now, &verdict);
+    if (accept != (guess == Guess::Accepted))
+      overturned[s] = true;
     if (!accept)
       continue;
     DualMesh &                solution = m_Population[s];
@@ -890,13 +966,29 @@ MoRvGomea::AcceptCandidates(CandidateBatch & candidateBatch, const std::vector<P
     for (std::size_t k = 0; k < element.dependentTetrahedra.size(); ++k)
       m_TetValues[s][element.dependentTetrahedra[k]] = values[k];
     m_Totals[s] = totals;
-    changed[s] = true;
     m_Ids[s] = m_NextId++;
-    m_Archive->Insert(next, solution, m_Ids[s], verdict);
+    m_Archive->Insert(*next, solution, m_Ids[s], verdict);
     c.accepted = true;
     ++accepted;
   }
   return accepted;
+}
+
+bool
+MoRvGomea::Accepted(const Candidate & c, const Fitness & next, const Fitness & now, ArchiveVerdict * verdict) const
+{
+  if (c.forced)
+    return ConstraintDominates(next, now);
+  if (c.singleObjective >= 0)
+  {
+    const auto m = static_cast<std::size_t>(c.singleObjective);
+    if (next.feasible != now.feasible)
+      return next.feasible;
+    if (!next.feasible)
+      return next.constraint < now.constraint;
+    return next.objectives[m] < now.objectives[m];
+  }
+  return ConstraintDominates(next, now) || (verdict != nullptr && m_Archive->Accepts(next, *verdict));
 }
 
 void
