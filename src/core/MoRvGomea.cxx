@@ -846,8 +846,9 @@ MoRvGomea::AcceptCandidates(CandidateBatch & candidateBatch, const std::vector<P
   //    ordered pass then only brings the verdicts up to date
   //    (ElitistArchive::Accepts(f, verdict) looks at newer entries only),
   //    passes over those refused for good, and applies the acceptances. Late
-  //    in a paper-scale run on 16 cores this halved the ordered pass (about
-  //    0.033 to 0.017 s per generation). Where the archive's changes overturn a
+  //    in a paper-scale run on 16 cores, timed in two leases of one machine
+  //    type, the ordered pass took 0.033 s per generation before and 0.017 s
+  //    after. Where the archive's changes overturn a
   //    chain's guess, the rest of that chain is judged afresh in the ordered
   //    pass, as it would be without the chains: decisions and sums are those
   //    of a plain ordered pass.
