@@ -14,6 +14,8 @@
 #                  JSON prints where the device's time went (device_phase_seconds).
 #                  bench/run-device-benchmark.sh late OUTDIR SECONDS BACKEND [GENERATIONS]
 #                  does both on the GPU machine.
+#   Kernels of several builds: bench/run-device-benchmark.sh early OUTDIR GENERATIONS ROUNDS
+#                  BACKEND PROGRAM... times early generations from scratch, programs in turns.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 DATA=${MOREA_DATA:-../shared/data/abdomen-cbct-pair}
@@ -89,13 +91,16 @@ case "${1:-}" in
     mkdir -p "$out" /tmp/b /tmp/ab
     [ -x /tmp/b/bin/morea ] || tar xJf device-carry/bundle.tar.xz -C /tmp/b
     export LD_LIBRARY_PATH=/tmp/b/lib
-    rm -rf /tmp/ab/start
-    register /tmp/b/bin/morea /tmp/ab/start "$seconds" "$backend" || true
-    tail -n 3 /tmp/ab/start/register.log > "$out/start-tail.log"
+    # The common start lives outside /tmp/ab, where each program has a
+    # folder of its name.
+    start=/tmp/ab-common-start
+    rm -rf "$start"
+    register /tmp/b/bin/morea "$start" "$seconds" "$backend" || true
+    tail -n 3 "$start/register.log" > "$out/start-tail.log"
     for program in "$@"; do
       name=$(basename "$program")
       rm -rf "/tmp/ab/$name"
-      cp -r /tmp/ab/start "/tmp/ab/$name"
+      cp -r "$start" "/tmp/ab/$name"
       mkdir -p "$out/$name"
       register "$program" "/tmp/ab/$name" 600 "$backend" || true
       tail -n 12 "/tmp/ab/$name/register.log" > "$out/$name/register-tail.log"
