@@ -198,6 +198,14 @@ public:
     static_cast<void>(head);
   }
 
+  /** Whether StartNextPartials would start a head now (from `ready`): the
+   *  caller works out the head only then. False by default. */
+  virtual bool
+  WantsNextPartials() const
+  {
+    return false;
+  }
+
   /** Fold checks and repair of later EvaluatePartials calls; the constraint
    *  and base mesh must outlive them. */
   virtual void

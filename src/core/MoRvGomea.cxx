@@ -784,8 +784,9 @@ MoRvGomea::ProcessCandidates(CandidateBatch & candidateBatch, GenerationRecord &
     accepted += AcceptCandidates(candidateBatch, batch, folds, begin, end, record);
     // The next batch's candidates of solutions this batch has finished with
     // (a prefix: both batches take the solutions in one order) are final:
-    // the backend may start on them while the rest is handed over.
-    if (next && next->partialsBuilt && end < candidates.size())
+    // the backend may start on them while the rest is handed over (when it
+    // takes them: during one part of the batch).
+    if (next && next->partialsBuilt && end < candidates.size() && m_Backend.WantsNextPartials())
     {
       std::vector<bool> pending(m_Population.size(), false);
       for (std::size_t i = end; i < candidates.size(); ++i)

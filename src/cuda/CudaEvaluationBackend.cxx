@@ -389,10 +389,16 @@ public:
    *  their parents and queues their fold checks behind the current batch's
    *  last part, so that the device checks them while the caller accepts that
    *  part (only while the next-to-last part is handed over). */
+  bool
+  WantsNextPartials() const override
+  {
+    return m_AcceptHead && !m_Head.open;
+  }
+
   void
   StartNextPartials(const std::vector<PartialCandidate> & next, std::size_t head) override
   {
-    if (!m_AcceptHead || m_Head.open || head == 0 || head > next.size())
+    if (!WantsNextPartials() || head == 0 || head > next.size())
       return;
     HostCandidates & h = m_HostCandidates[1 - m_CurrentHost];
     if (!h.PackedFor(next) || h.firstItem[next.size()] == 0 || h.largestChecked > cuda::MaxRepairElementPoints)
