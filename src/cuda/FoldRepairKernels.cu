@@ -63,7 +63,7 @@ VolumeViolation(const FoldRepairConstants & k, std::uint32_t t, const double * c
       corners[3 * j + a] = c[j][a];
   double count = 0.0;
   const double value =
-    device::VolumeViolation(device::SignedVolume(corners), k.referenceVolumes[t], k.volumeFraction, count);
+    device::CornersVolumeViolation(corners, k.referenceVolumes[t], k.volumeFraction, count);
   folded = count > 0.0;
   return value;
 }
@@ -266,8 +266,7 @@ StarViolation(const FoldRepairConstants & k, const PointStar & star, const doubl
                              : j < slot ? other[3 * (j < 2 ? j : 2) + a]
                                         : other[3 * (j > 1 ? j - 1 : 0) + a];
     double count = 0.0;
-    value = Add(value, device::VolumeViolation(device::SignedVolume(corners), star.referenceVolume[i],
-                                               k.volumeFraction, count));
+    value = Add(value, device::CornersVolumeViolation(corners, star.referenceVolume[i], k.volumeFraction, count));
     folded += count > 0.0;
     if (value > bound)
       return false;

@@ -92,9 +92,10 @@ TetrahedronSeed(const double c[12])
   return h;
 }
 
-/** Signed volume, rounded exactly as the CPU computes it (no contraction). */
+/** Six times the signed volume (the triple product), rounded exactly as
+ *  the CPU computes it (no contraction). */
 inline __device__ double
-SignedVolume(const double c[12])
+SixfoldSignedVolume(const double c[12])
 {
   const double ux = __dsub_rn(c[3], c[0]), uy = __dsub_rn(c[4], c[1]), uz = __dsub_rn(c[5], c[2]);
   const double vx = __dsub_rn(c[6], c[0]), vy = __dsub_rn(c[7], c[1]), vz = __dsub_rn(c[8], c[2]);
@@ -102,7 +103,14 @@ SignedVolume(const double c[12])
   const double a = __dmul_rn(ux, __dsub_rn(__dmul_rn(vy, wz), __dmul_rn(vz, wy)));
   const double b = __dmul_rn(uy, __dsub_rn(__dmul_rn(vx, wz), __dmul_rn(vz, wx)));
   const double d = __dmul_rn(uz, __dsub_rn(__dmul_rn(vx, wy), __dmul_rn(vy, wx)));
-  return __ddiv_rn(__dadd_rn(__dsub_rn(a, b), d), 6.0);
+  return __dadd_rn(__dsub_rn(a, b), d);
+}
+
+/** Signed volume, rounded exactly as the CPU computes it. */
+inline __device__ double
+SignedVolume(const double c[12])
+{
+  return __ddiv_rn(SixfoldSignedVolume(c), 6.0);
 }
 
 inline __device__ double
@@ -122,6 +130,23 @@ VolumeViolation(double v, double reference, double fraction, double & folded)
     return __dsub_rn(oriented, __ddiv_rn(size, fraction));
   }
   return 0.0;
+}
+
+/** VolumeViolation(SignedVolume(c), ...), dividing only where the quotient
+ *  matters. Without a volume fraction (the lower bound is then 0 for a
+ *  finite reference) a tetrahedron oriented as its reference (six times its
+ *  volume above 1e-300, so that the correctly rounded sixth is positive
+ *  too) is not folded and adds 0, whatever the
+ *  quotient's last bits: the fold repair's trials meet mostly such
+ *  tetrahedra, and the double division was the longest chain of the
+ *  check. */
+inline __device__ double
+CornersVolumeViolation(const double c[12], double reference, double fraction, double & folded)
+{
+  const double six = SixfoldSignedVolume(c);
+  if (fraction == 0.0 && isfinite(reference) && (reference > 0.0 ? six : -six) > 1e-300)
+    return 0.0;
+  return VolumeViolation(__ddiv_rn(six, 6.0), reference, fraction, folded);
 }
 
 inline __device__ double
