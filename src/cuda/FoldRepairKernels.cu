@@ -202,6 +202,14 @@ struct PointStar
   double        referenceVolume[MaxStarTetrahedra];
   std::uint8_t  slot[MaxStarTetrahedra]; ///< where the point is among the 4 corners
   std::uint32_t count;
+  /** Per tetrahedron a term of a sum that the lanes compute side by side
+   *  and then add in order (StarViolationOfAll, StarDistance), and whether
+   *  it counts (folded, or a face that is not degenerate). */
+  double        term[MaxStarTetrahedra];
+  std::uint8_t  counts[MaxStarTetrahedra];
+  /** Per lane the position of its best trial so far: the winner's is read
+   *  from here instead of being drawn again. */
+  double        best[32][3];
 };
 
 /** Fills `star` for point p (whose tetrahedra number at most MaxStarTetrahedra). */
@@ -241,6 +249,32 @@ GatherStar(const FoldRepairConstants & k, const SideView & s, std::uint32_t p, u
   __syncwarp();
 }
 
+/** The violation of the star's tetrahedron i with the point at `position`. */
+__device__ double
+StarTetrahedronViolation(const FoldRepairConstants & k, const PointStar & star, std::uint32_t i,
+                         const double * position, bool & folded)
+{
+  double    other[9];
+  const int slot = star.slot[i];
+#pragma unroll
+  for (int c = 0; c < 9; ++c)
+    other[c] = star.corners[i][c];
+  // Corner j is stored at j before the point's slot and at j - 1 after it
+  // (the clamps only keep the unrolled indices in range).
+  double corners[12];
+#pragma unroll
+  for (int j = 0; j < 4; ++j)
+#pragma unroll
+    for (int a = 0; a < 3; ++a)
+      corners[3 * j + a] = j == slot ? position[a]
+                           : j < slot ? other[3 * (j < 2 ? j : 2) + a]
+                                      : other[3 * (j > 1 ? j - 1 : 0) + a];
+  double       count = 0.0;
+  const double value = device::CornersVolumeViolation(corners, star.referenceVolume[i], k.volumeFraction, count);
+  folded = count > 0.0;
+  return value;
+}
+
 /** PointViolation from the star, the point at `position`. */
 __device__ bool
 StarViolation(const FoldRepairConstants & k, const PointStar & star, const double * position, double bound,
@@ -250,40 +284,61 @@ StarViolation(const FoldRepairConstants & k, const PointStar & star, const doubl
   folded = 0;
   for (std::uint32_t i = 0; i < star.count; ++i)
   {
-    double    other[9];
-    const int slot = star.slot[i];
-#pragma unroll
-    for (int c = 0; c < 9; ++c)
-      other[c] = star.corners[i][c];
-    // Corner j is stored at j before the point's slot and at j - 1 after it
-    // (the clamps only keep the unrolled indices in range).
-    double corners[12];
-#pragma unroll
-    for (int j = 0; j < 4; ++j)
-#pragma unroll
-      for (int a = 0; a < 3; ++a)
-        corners[3 * j + a] = j == slot ? position[a]
-                             : j < slot ? other[3 * (j < 2 ? j : 2) + a]
-                                        : other[3 * (j > 1 ? j - 1 : 0) + a];
-    double count = 0.0;
-    value = Add(value, device::CornersVolumeViolation(corners, star.referenceVolume[i], k.volumeFraction, count));
-    folded += count > 0.0;
+    bool f = false;
+    value = Add(value, StarTetrahedronViolation(k, star, i, position, f));
+    folded += f;
     if (value > bound)
       return false;
   }
   return true;
 }
 
-/** DistanceToSurroundingPolyhedron from the star. */
-__device__ double
-StarDistance(const PointStar & star, const double * x)
+/** StarViolation without a bound, the same value for every lane: the lanes
+ *  compute the terms side by side, then each adds them in order. (Every
+ *  lane going through all the terms itself was a sixth of the repair's
+ *  time, as was the same for StarDistance.) */
+__device__ void
+StarViolationOfAll(const FoldRepairConstants & k, PointStar & star, const double * position, unsigned lane,
+                   double & value, std::uint32_t & folded)
 {
-  MeanFaceDistance mean;
+  __syncwarp(); // no lane still reads the terms of the previous sum
+  for (std::uint32_t i = lane; i < star.count; i += 32)
+  {
+    bool f = false;
+    star.term[i] = StarTetrahedronViolation(k, star, i, position, f);
+    star.counts[i] = f;
+  }
+  __syncwarp();
+  value = 0.0;
+  folded = 0;
   for (std::uint32_t i = 0; i < star.count; ++i)
   {
-    const double * f[3] = { star.corners[i], star.corners[i] + 3, star.corners[i] + 6 };
-    mean.AddFace(f, x);
+    value = Add(value, star.term[i]);
+    folded += star.counts[i];
   }
+}
+
+/** DistanceToSurroundingPolyhedron from the star, the faces' distances
+ *  computed side by side, added in order by every lane (MeanFaceDistance). */
+__device__ double
+StarDistance(PointStar & star, const double * x, unsigned lane)
+{
+  __syncwarp(); // no lane still reads the terms of the previous sum
+  for (std::uint32_t i = lane; i < star.count; i += 32)
+  {
+    const double * f[3] = { star.corners[i], star.corners[i] + 3, star.corners[i] + 6 };
+    double         distance = 0.0;
+    star.counts[i] = FacePlaneDistance(f, x, distance);
+    star.term[i] = distance;
+  }
+  __syncwarp();
+  MeanFaceDistance mean;
+  for (std::uint32_t i = 0; i < star.count; ++i)
+    if (star.counts[i])
+    {
+      mean.sum = Add(mean.sum, star.term[i]);
+      ++mean.n;
+    }
   return mean.Value();
 }
 
@@ -360,13 +415,13 @@ RepairSide(const FoldRepairConstants & k, const SideView & s, const std::uint32_
       if (cached)
       {
         GatherStar(k, s, p, lane, star);
-        StarViolation(k, star, original, INFINITY, currentValue, currentFolded);
+        StarViolationOfAll(k, star, original, lane, currentValue, currentFolded);
       }
       else
         PointViolation(k, s, p, nullptr, INFINITY, currentValue, currentFolded);
       if (currentFolded == 0)
         continue; // fixed by an earlier move in this pass
-      const double scale = cached ? StarDistance(star, original) : DistanceToSurroundingPolyhedron(k, s, p);
+      const double scale = cached ? StarDistance(star, original, lane) : DistanceToSurroundingPolyhedron(k, s, p);
       if (!(scale > 0.0))
         continue;
 
@@ -376,19 +431,30 @@ RepairSide(const FoldRepairConstants & k, const SideView & s, const std::uint32_
       double        bestValue = currentValue;
       std::uint32_t bestFolded = currentFolded;
       std::uint32_t bestTrial = NoPoint;
-      for (std::uint32_t trial = lane; trial < k.samplesPerPoint; trial += 32)
+      for (std::uint32_t first = 0; first < k.samplesPerPoint; first += 32) // warp-uniform
       {
+        // A trial whose partial sum passes the lowest value any lane has
+        // found so far cannot be kept: the sums only grow (terms >= 0).
+        double bound = bestValue;
+        if (first > 0)
+          for (int offset = 16; offset > 0; offset /= 2)
+            bound = fmin(bound, __shfl_xor_sync(FullMask, bound, offset));
+        const std::uint32_t trial = first + lane;
+        if (trial >= k.samplesPerPoint)
+          continue;
         double candidate[3];
         TrialPosition(k, seed, round, p, trial, original, scale, pin, candidate);
         double        value = 0.0;
         std::uint32_t folded = 0;
-        const bool    within = cached ? StarViolation(k, star, candidate, bestValue, value, folded)
-                                      : PointViolation(k, s, p, candidate, bestValue, value, folded);
+        const bool    within = cached ? StarViolation(k, star, candidate, bound, value, folded)
+                                      : PointViolation(k, s, p, candidate, bound, value, folded);
         if (within && (value < bestValue || (value <= bestValue && folded < bestFolded)))
         {
           bestValue = value;
           bestFolded = folded;
           bestTrial = trial;
+          for (int a = 0; a < 3; ++a)
+            star.best[lane][a] = candidate[a];
         }
       }
       for (int offset = 16; offset > 0; offset /= 2)
@@ -408,9 +474,9 @@ RepairSide(const FoldRepairConstants & k, const SideView & s, const std::uint32_
       }
       if (bestTrial == NoPoint)
         continue;
-      double chosen[3];
-      TrialPosition(k, seed, round, p, bestTrial, original, scale, pin, chosen);
-      __syncwarp();
+      __syncwarp(); // the winning lane's position is written
+      const double chosen[3] = { star.best[bestTrial % 32][0], star.best[bestTrial % 32][1],
+                                 star.best[bestTrial % 32][2] };
       if (lane == 0)
         for (int a = 0; a < 3; ++a)
           position[a] = chosen[a];
