@@ -3,7 +3,7 @@
 // counts only samples within the radius of a contour, and with tetrahedra far
 // larger than the radius most samples of a tetrahedron near a contour are
 // not: the CUDA texture sampling reads a sample's distance only in a marked
-// block (a byte per block instead of a filtered fetch per sample).
+// block (a bit per block instead of a filtered fetch per sample).
 #ifndef morea_NearContourBlocks_h
 #define morea_NearContourBlocks_h
 

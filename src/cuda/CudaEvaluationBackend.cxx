@@ -492,8 +492,12 @@ private:
         view.distanceTexture = static_cast<unsigned long long>(textures.distance->Get());
         view.distanceChannels = channels;
         const NearContourBlocks near = FindNearContourBlocks(volume, m_Constants.guidanceRadius);
-        textures.nearBlocks.Reserve(near.mask.size());
-        Check(cudaMemcpy(textures.nearBlocks.Data(), near.mask.data(), near.mask.size(), cudaMemcpyHostToDevice),
+        // One bit per block, so that the mask stays small enough for L1.
+        std::vector<std::uint8_t> bits((near.mask.size() + 7) / 8, 0);
+        for (std::size_t b = 0; b < near.mask.size(); ++b)
+          bits[b / 8] |= static_cast<std::uint8_t>((near.mask[b] != 0 ? 1u : 0u) << (b % 8));
+        textures.nearBlocks.Reserve(bits.size());
+        Check(cudaMemcpy(textures.nearBlocks.Data(), bits.data(), bits.size(), cudaMemcpyHostToDevice),
               "uploading the near-contour blocks");
         view.nearBlocks = textures.nearBlocks.Data();
         for (int a = 0; a < 3; ++a)

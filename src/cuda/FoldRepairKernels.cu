@@ -492,6 +492,11 @@ RepairSide(const FoldRepairConstants & k, const SideView & s, const std::uint32_
   return false;
 }
 
+/** One warp per side of a candidate. Tried and not kept (H100, late
+ *  generations, fold checks per generation): at most 80 registers for 6
+ *  resident blocks per SM (a few spills), 0.0432 s against 0.0421 s; a
+ *  trial first summing the tetrahedra violated at the current position, to
+ *  stop sooner, 0.0458 s against 0.0435 s. */
 __global__ void
 CheckCandidateFolds(CandidateBatch b, FoldRepairConstants k, const std::uint8_t * check,
                     const std::uint64_t * sideSeeds, double * moved, std::uint8_t * outcome, std::size_t first,

@@ -302,7 +302,8 @@ MayBeNearContour(const std::uint8_t * __restrict__ nearBlocks, const int blocks[
 #pragma unroll
   for (int a = 0; a < 3; ++a)
     b[a] = min(max(__float2int_rd((p[a] - 0.5f) * (1.0f / NearBlockSize)), 0), blocks[a] - 1);
-  return __ldg(nearBlocks + (static_cast<std::size_t>(b[2]) * blocks[1] + b[1]) * blocks[0] + b[0]) != 0;
+  const std::size_t block = (static_cast<std::size_t>(b[2]) * blocks[1] + b[1]) * blocks[0] + b[0];
+  return ((__ldg(nearBlocks + block / 8) >> (block % 8)) & 1u) != 0;
 }
 
 /** Samples rows j, j + 1, ... of a chunk (32 samples each) up to the
@@ -355,7 +356,7 @@ SampleRows(const SamplingConstants & k, const float4 * corners, std::uint32_t j,
       else if (a > 0.0f || b > 0.0f)
         intensity += 1.0f;
       // The sampled distance only where the sample's block may be within
-      // the radius (a byte read mostly from L1 instead of a filtered fetch),
+      // the radius (a bit read mostly from L1 instead of a filtered fetch),
       // the mapped one only where the sampled one is: most samples of a task
       // near a contour are not.
       if (near && MayBeNearContour(fromNearBlocks, fromBlocks, p))
@@ -414,7 +415,14 @@ SampleRows(const SamplingConstants & k, const float4 * corners, std::uint32_t j,
  *    texture units' data pipe is the limit (81 % busy, the load path 27 %):
  *    8.09e10 samples per second when tasks of at most 1024 samples used it,
  *    7.06e10 when all did, against 8.33e10; the bricks' eightfold footprint
- *    costs more in L1 than the second pipe gains. */
+ *    costs more in L1 than the second pipe gains;
+ *  - lanes taking samples that differ in the high bits of an aligned block's
+ *    Gray codes (the same points): 8.32e10 against 8.33e10. Flipping a high
+ *    index bit moves Sobol dimensions 2-4 by a direction number with
+ *    arbitrary high bits, so those points are no closer together. A
+ *    diagnostic build whose 32 lanes differed only in dimension 1 (wrong
+ *    values) reached 1.13e11: close points would pay, but with these points
+ *    only sorting them finds close ones. */
 __device__ void
 SampleChunk(const SamplingConstants & k, const SampleTask * __restrict__ tasks,
             const std::uint32_t * __restrict__ taskFirstChunk, const std::uint32_t * __restrict__ chunkTask,
