@@ -82,19 +82,30 @@ TetrahedronViolation(const FoldRepairConstants & k, const SideView & s, std::uin
   return VolumeViolation(k, t, c, folded);
 }
 
-/** Whether any of the `n` tetrahedra folds (lanes share them). */
-__device__ bool
-AnyFolded(const FoldRepairConstants & k, const SideView & s, const std::uint32_t * tets, std::uint32_t n,
-          unsigned lane)
+/** The element's points (bits of their local indices) that lie in a folded
+ *  tetrahedron among the `n` (lanes share them), the same for every lane.
+ *  Every one of those tetrahedra has a point of the element, so the result is
+ *  0 exactly when none folds. */
+__device__ unsigned long long
+FoldedElementPoints(const FoldRepairConstants & k, const SideView & s, const std::uint32_t * tets, std::uint32_t n,
+                    unsigned lane)
 {
-  bool any = false;
+  unsigned long long flagged = 0;
   for (std::uint32_t i = lane; i < n; i += 32)
   {
     bool folded = false;
     TetrahedronViolation(k, s, tets[i], NoPoint, nullptr, folded);
-    any = any || folded;
+    if (folded)
+      for (int j = 0; j < 4; ++j)
+      {
+        const int local = s.Local(s.tetrahedra[4 * static_cast<std::size_t>(tets[i]) + j]);
+        if (local >= 0)
+          flagged |= 1ull << local;
+      }
   }
-  return __any_sync(FullMask, any);
+  for (int offset = 16; offset > 0; offset /= 2)
+    flagged |= __shfl_xor_sync(FullMask, flagged, offset);
+  return flagged;
 }
 
 /** BoundedViolation: the sum over point p's tetrahedra in ascending order,
@@ -359,27 +370,11 @@ TrialPosition(const FoldRepairConstants & k, std::uint64_t seed, std::uint32_t r
 /** RepairPoints over one side; true when it ends fold-free. */
 __device__ bool
 RepairSide(const FoldRepairConstants & k, const SideView & s, const std::uint32_t * dependent, std::uint32_t n,
+           unsigned long long flagged,
            std::uint64_t seed, unsigned lane, PointStar & star)
 {
   for (std::uint32_t round = 0; round < k.maxRounds; ++round)
   {
-    // The element's points in a folded tetrahedron.
-    unsigned long long flagged = 0;
-    for (std::uint32_t i = lane; i < n; i += 32)
-    {
-      bool folded = false;
-      TetrahedronViolation(k, s, dependent[i], NoPoint, nullptr, folded);
-      if (folded)
-        for (int j = 0; j < 4; ++j)
-        {
-          const int local = s.Local(s.tetrahedra[4 * static_cast<std::size_t>(dependent[i]) + j]);
-          if (local >= 0)
-            flagged |= 1ull << local;
-        }
-    }
-    for (int offset = 16; offset > 0; offset /= 2)
-      flagged |= __shfl_xor_sync(FullMask, flagged, offset);
-
     bool          movedAny = false;
     std::uint32_t previous = 0;
     bool          first = true;
@@ -484,7 +479,9 @@ RepairSide(const FoldRepairConstants & k, const SideView & s, const std::uint32_
       if (chosen[0] != original[0] || chosen[1] != original[1] || chosen[2] != original[2])
         movedAny = true;
     }
-    if (!AnyFolded(k, s, dependent, n, lane))
+    // The next round's points: the check that ends this round finds them.
+    flagged = FoldedElementPoints(k, s, dependent, n, lane);
+    if (flagged == 0)
       return true;
     if (!movedAny)
       return false;
@@ -523,10 +520,11 @@ CheckCandidateFolds(CandidateBatch b, FoldRepairConstants k, const std::uint8_t 
   const std::uint32_t   n = b.elementTetrahedronOffsets[e + 1] - b.elementTetrahedronOffsets[e];
 
   std::uint8_t result = 0;
-  if (AnyFolded(k, s, dependent, n, lane))
+  const unsigned long long flagged = FoldedElementPoints(k, s, dependent, n, lane);
+  if (flagged != 0)
   {
     result = SideFolded;
-    if (k.repair && RepairSide(k, s, dependent, n, sideSeeds[2 * c + side], lane, stars[threadIdx.x / 32]))
+    if (k.repair && RepairSide(k, s, dependent, n, flagged, sideSeeds[2 * c + side], lane, stars[threadIdx.x / 32]))
       result |= SideRepaired;
   }
   if (lane == 0)
