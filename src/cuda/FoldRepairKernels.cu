@@ -305,9 +305,9 @@ StarViolation(const FoldRepairConstants & k, const PointStar & star, const doubl
 }
 
 /** StarViolation without a bound, the same value for every lane: the lanes
- *  compute the terms side by side, then each adds them in order. (Every
- *  lane going through all the terms itself was a sixth of the repair's
- *  time, as was the same for StarDistance.) */
+ *  compute the terms side by side, then each adds them in order. (With each
+ *  lane going through all the terms itself, this took a sixth of the
+ *  repair's time, and StarDistance as much.) */
 __device__ void
 StarViolationOfAll(const FoldRepairConstants & k, PointStar & star, const double * position, unsigned lane,
                    double & value, std::uint32_t & folded)
@@ -367,11 +367,11 @@ TrialPosition(const FoldRepairConstants & k, std::uint64_t seed, std::uint32_t r
   }
 }
 
-/** RepairPoints over one side; true when it ends fold-free. */
+/** RepairPoints over one side, whose element points in a folded tetrahedron
+ *  are `flagged` (FoldedElementPoints); true when it ends fold-free. */
 __device__ bool
 RepairSide(const FoldRepairConstants & k, const SideView & s, const std::uint32_t * dependent, std::uint32_t n,
-           unsigned long long flagged,
-           std::uint64_t seed, unsigned lane, PointStar & star)
+           unsigned long long flagged, std::uint64_t seed, unsigned lane, PointStar & star)
 {
   for (std::uint32_t round = 0; round < k.maxRounds; ++round)
   {

@@ -134,12 +134,11 @@ VolumeViolation(double v, double reference, double fraction, double & folded)
 
 /** VolumeViolation(SignedVolume(c), ...), dividing only where the quotient
  *  matters. Without a volume fraction (the lower bound is then 0 for a
- *  finite reference) a tetrahedron oriented as its reference (six times its
- *  volume above 1e-300, so that the correctly rounded sixth is positive
- *  too) is not folded and adds 0, whatever the
- *  quotient's last bits: the fold repair's trials meet mostly such
- *  tetrahedra, and the double division was the longest chain of the
- *  check. */
+ *  finite reference), a tetrahedron oriented as its reference (six times its
+ *  volume above 1e-300, so that the correctly rounded sixth has the same
+ *  sign) is not folded and adds 0, whatever the quotient's last bits. The
+ *  fold repair's trials meet mostly such tetrahedra, and the double
+ *  division was the longest chain of the check. */
 inline __device__ double
 CornersVolumeViolation(const double c[12], double reference, double fraction, double & folded)
 {
