@@ -573,9 +573,6 @@ private:
         slot = e.first->second;
         if (e.second)
         {
-          // The fold kernel flags an element's points in a 64-bit mask.
-          if (c.element->points.size() > 64)
-            throw Error("CUDA backend: fold checks need elements of at most 64 points");
           slotElements.push_back(c.element);
           h.points.insert(h.points.end(), c.element->points.begin(), c.element->points.end());
           h.pointOffsets.push_back(static_cast<std::uint32_t>(h.points.size()));

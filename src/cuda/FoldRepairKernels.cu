@@ -82,7 +82,8 @@ TetrahedronViolation(const FoldRepairConstants & k, const SideView & s, std::uin
   return VolumeViolation(k, t, c, folded);
 }
 
-/** The element's points (bits of their local indices) that lie in a folded
+/** The element's points (bits of their local indices: at most
+ *  MaxRepairElementPoints, as the backend checks) that lie in a folded
  *  tetrahedron among the `n` (lanes share them), the same for every lane.
  *  Every one of those tetrahedra has a point of the element, so the result is
  *  0 exactly when none folds. */
@@ -159,8 +160,12 @@ struct MeanFaceDistance
   AddFace(const double * const f[3], const double * x)
   {
     double distance = 0.0;
-    if (!FacePlaneDistance(f, x, distance))
-      return;
+    if (FacePlaneDistance(f, x, distance))
+      AddDistance(distance);
+  }
+  __device__ void
+  AddDistance(double distance)
+  {
     sum = Add(sum, distance);
     ++n;
   }
@@ -346,10 +351,7 @@ StarDistance(PointStar & star, const double * x, unsigned lane)
   MeanFaceDistance mean;
   for (std::uint32_t i = 0; i < star.count; ++i)
     if (star.counts[i])
-    {
-      mean.sum = Add(mean.sum, star.term[i]);
-      ++mean.n;
-    }
+      mean.AddDistance(star.term[i]);
   return mean.Value();
 }
 
