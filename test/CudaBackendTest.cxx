@@ -362,6 +362,53 @@ TEST(CudaEvaluationBackend, TextureInterpolationStaysCloseToTheCpu)
   }
 }
 
+// Tetrahedra of more than 512 samples are sampled in whole chunks whose
+// lanes take the points in another order (cosets of an index subspace). On
+// voxel noise, every tetrahedron's sum must match the CPU's points; as a
+// check that the tolerance can fail, another point set (the same mesh moved
+// by 1e-9 mm, so other seeds) must differ from the CPU's by more than it.
+TEST(CudaEvaluationBackend, TextureWholeChunksSampleTheCpuPoints)
+{
+  MOREA_REQUIRE_CUDA_DEVICE();
+  OptimiserTestProblem problem;
+  RandomGenerator      noise(17);
+  for (ChannelVolume * image : { &problem.data.fixed, &problem.data.moving })
+    for (std::size_t v = 0; v < image->data.size(); v += 2)
+      image->data[v] = static_cast<float>(0.2 + 0.8 * noise.Uniform());
+  problem.data.samplingRate = 16.0;
+  GomeaOptions options = problem.Options(9);
+  options.populationSize = 2;
+  const auto population = problem.InitialPopulation(options);
+  DualMesh   moved = population[1];
+  for (Vec3 & p : moved.source)
+    p[0] += 1e-9;
+  auto cpu = CreateCpuEvaluationBackend(*problem.evaluator, 2);
+  auto texture = CreateCudaEvaluationBackend(*problem.evaluator, 2, CudaInterpolation::Texture);
+  std::vector<TetrahedronValues> a, b, c;
+  cpu->EvaluateSolutions({ &population[1] }, { &a });
+  texture->EvaluateSolutions({ &population[1] }, { &b });
+  cpu->EvaluateSolutions({ &moved }, { &c });
+  ASSERT_EQ(a.size(), b.size());
+  std::size_t wholeChunks = 0, otherPointsDiffer = 0;
+  double      worst = 0.0;
+  for (std::size_t t = 0; t < a.size(); ++t)
+  {
+    EXPECT_EQ(a[t].samples, b[t].samples);
+    if (a[t].samples < 1100.0) // both directions: at least one whole chunk
+      continue;
+    ++wholeChunks;
+    const double relative = std::abs(a[t].intensity - b[t].intensity) / a[t].intensity;
+    worst = std::max(worst, relative);
+    EXPECT_LT(relative, 3e-3) << "tetrahedron " << t << ": cpu " << a[t].intensity << " cuda " << b[t].intensity;
+    if (std::abs(a[t].intensity - c[t].intensity) / a[t].intensity > 3e-3)
+      ++otherPointsDiffer;
+  }
+  std::cout << wholeChunks << " tetrahedra with whole chunks, largest relative difference " << worst << ", "
+            << otherPointsDiffer << " differ with other points\n";
+  EXPECT_GE(wholeChunks, 50u);
+  EXPECT_GE(otherPointsDiffer, wholeChunks * 3 / 4);
+}
+
 TEST(EvaluationBackendSelection, NamesAndDeviceAbsence)
 {
   EXPECT_EQ(ParseBackendChoice("cpu"), BackendChoice::Cpu);
