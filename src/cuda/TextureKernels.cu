@@ -469,8 +469,8 @@ SampleCosets(const SamplingConstants & k, const float4 * corners, bool near, std
  *    index bit moves Sobol dimensions 2-4 by a direction number with
  *    arbitrary high bits, so those points are no closer together. A
  *    diagnostic build whose 32 lanes differed only in dimension 1 (wrong
- *    values) reached 1.13e11: close points would pay, but with these points
- *    only sorting them finds close ones. */
+ *    values) reached 1.13e11: close points pay. Offsets chosen from the
+ *    whole block, not single bits, find them (CosetBasis). */
 __device__ void
 SampleChunk(const SamplingConstants & k, const SampleTask * __restrict__ tasks,
             const std::uint32_t * __restrict__ taskFirstChunk, const std::uint32_t * __restrict__ chunkTask,
