@@ -18,8 +18,9 @@
 #include <cub/device/device_radix_sort.cuh>
 #include <cub/device/device_scan.cuh>
 
-#include <algorithm>
+#include <array>
 #include <cstdint>
+#include <vector>
 
 namespace morea::cuda
 {
@@ -506,7 +507,7 @@ SampleChunk(const SamplingConstants & k, const ChunkHeader & h, std::size_t chun
             double2 * chunkSums)
 {
   const int     direction = static_cast<int>(h.task & 1u);
-  std::uint32_t j = h.local * k.chunkIterations;
+  const std::uint32_t j = h.local * k.chunkIterations;
   const bool    cosets = k.chunkIterations == CosetRows && 32 * (j + CosetRows) <= h.n; // uniform
   const uint4   lanePart = cosets ? g_CosetLaneSobol[lane] : g_LaneSobol[lane];
   std::uint32_t state[4] = { h.shift.x ^ lanePart.x, h.shift.y ^ lanePart.y, h.shift.z ^ lanePart.z,
@@ -593,19 +594,6 @@ UploadTextureSobolDirections(const std::uint32_t * directions)
 {
   Check(cudaMemcpyToSymbol(c_SobolDirections, directions, sizeof(std::uint32_t) * 4 * 32),
         "copying the Sobol direction numbers");
-  uint4 lanes[32];
-  for (std::uint32_t lane = 0; lane < 32; ++lane)
-  {
-    const std::uint32_t gray = lane ^ (lane >> 1);
-    std::uint32_t       part[4] = { 0, 0, 0, 0 };
-    for (int d = 0; d < 4; ++d)
-      for (int b = 0; b < 5; ++b)
-        if ((gray >> b) & 1u)
-          part[d] ^= directions[d * 32 + b];
-    lanes[lane] = make_uint4(part[0], part[1], part[2], part[3]);
-  }
-  Check(cudaMemcpyToSymbol(g_LaneSobol, lanes, sizeof(lanes)), "copying the lanes' Sobol parts");
-
   // The state part of an index offset x < 2^9: its Gray code's directions.
   const auto part = [directions](std::uint32_t x) {
     const std::uint32_t gray = x ^ (x >> 1);
@@ -620,34 +608,42 @@ UploadTextureSobolDirections(const std::uint32_t * directions)
       }
     return p;
   };
-  uint4 cosetLanes[32];
+  uint4 lanes[32], cosetLanes[32];
   for (std::uint32_t lane = 0; lane < 32; ++lane)
   {
+    lanes[lane] = part(lane);
     std::uint32_t x = 0;
     for (int b = 0; b < 5; ++b)
       if ((lane >> b) & 1u)
         x ^= CosetBasis[b];
     cosetLanes[lane] = part(x);
   }
-  // A complement of W from unit vectors, in order; span tracks W + chosen.
-  std::uint32_t span[512];
-  std::uint32_t spanSize = 1;
-  span[0] = 0;
+  Check(cudaMemcpyToSymbol(g_LaneSobol, lanes, sizeof(lanes)), "copying the lanes' Sobol parts");
+
+  // W's basis, then a complement from unit vectors: each vector added must
+  // double the set of indices spanned, up to all 512.
+  std::array<bool, 512>      spanned{};
+  std::vector<std::uint32_t> members{ 0 };
+  spanned[0] = true;
   const auto add = [&](std::uint32_t v) {
-    for (std::uint32_t i = 0, size = spanSize; i < size; ++i)
-      span[spanSize++] = span[i] ^ v;
+    if (spanned[v])
+      return false;
+    for (std::size_t i = 0, size = members.size(); i < size; ++i)
+    {
+      members.push_back(members[i] ^ v);
+      spanned[members.back()] = true;
+    }
+    return true;
   };
+  bool independent = true;
   for (std::uint32_t v : CosetBasis)
-    add(v);
+    independent = add(v) && independent;
   uint4 rowSteps[4];
   int   steps = 0;
   for (std::uint32_t b = 0; b < 9 && steps < 4; ++b)
-    if (std::find(span, span + spanSize, 1u << b) == span + spanSize)
-    {
+    if (add(1u << b))
       rowSteps[steps++] = part(1u << b);
-      add(1u << b);
-    }
-  if (steps != 4 || spanSize != 512)
+  if (!independent || steps != 4)
     throw Error("CUDA backend: the Sobol coset basis does not span the chunk's indices");
   Check(cudaMemcpyToSymbol(g_CosetLaneSobol, cosetLanes, sizeof(cosetLanes)), "copying the lanes' coset parts");
   Check(cudaMemcpyToSymbol(c_CosetRowSteps, rowSteps, sizeof(rowSteps)), "copying the cosets' row steps");
