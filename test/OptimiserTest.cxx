@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <iostream>
 #include <iterator>
 #include <random>
 #include <sstream>
@@ -48,6 +49,10 @@ public:
   {
     std::vector<PartialCandidate> shuffled = candidates;
     std::shuffle(shuffled.begin(), shuffled.end(), m_Random);
+    if (m_HasRefusalScreen)
+      m_Cpu->SetRefusalScreen(m_RefusalScreen);
+    else
+      m_Cpu->ClearRefusalScreen();
     m_Cpu->EvaluatePartials(shuffled);
     // After the evaluation (the CPU backend calls it before).
     if (meanwhile)
@@ -65,6 +70,11 @@ public:
   {
     EvaluationBackend::SetFoldHandling(handling);
     m_Cpu->SetFoldHandling(handling);
+  }
+  void
+  SampleSkipped(const std::vector<PartialCandidate> & candidates, const std::vector<std::size_t> & which) override
+  {
+    m_Cpu->SampleSkipped(candidates, which);
   }
 
 private:
@@ -165,6 +175,56 @@ TEST(MoRvGomea, SameSeedSameFrontWhateverTheThreadsOrEvaluationOrder)
   EXPECT_EQ(a, RunToEnd(problem, *three, fourHostThreads));
   const auto d = RunToEnd(problem, *one, problem.Options(22, 6));
   EXPECT_NE(a, d);
+}
+
+TEST(MoRvGomea, RefusalBoundsSpareSamplesAndChangeNoDecision)
+{
+  // Candidates whose bound (RefusalBound.h) is refused go unsampled; the
+  // optimiser samples those its exact check does not refuse. The fronts,
+  // ids and acceptance counts must be those of a run that samples all.
+  OptimiserTestProblem problem;
+  GomeaOptions         options = problem.Options(31, 12);
+  GomeaOptions         sampleAll = options;
+  sampleAll.boundRefusals = false;
+  const auto run = [&](EvaluationBackend & backend, const GomeaOptions & o) {
+    MoRvGomea optimiser(problem.base, problem.topology, problem.parallel, *problem.constraint, backend, o);
+    optimiser.Initialize(problem.InitialPopulation(o));
+    optimiser.Run();
+    return std::make_pair(optimiser.Archive().Entries(), optimiser.History());
+  };
+  auto       cpu = CreateCpuEvaluationBackend(*problem.evaluator, 2);
+  const auto all = run(*cpu, sampleAll);
+  const auto bounded = run(*cpu, options);
+  ShufflingBackend shuffling(*problem.evaluator); // handed over in parts of random sizes
+  const auto       shuffled = run(shuffling, options);
+  ASSERT_EQ(all.first.size(), bounded.first.size());
+  ASSERT_EQ(all.first.size(), shuffled.first.size());
+  for (std::size_t i = 0; i < all.first.size(); ++i)
+  {
+    EXPECT_EQ(all.first[i].id, bounded.first[i].id);
+    EXPECT_EQ(all.first[i].fitness.objectives, bounded.first[i].fitness.objectives);
+    EXPECT_EQ(all.first[i].fitness.objectives, shuffled.first[i].fitness.objectives);
+    EXPECT_EQ(all.first[i].solution.source, bounded.first[i].solution.source);
+  }
+  std::size_t skipped = 0, later = 0;
+  double      spared = 0.0, drawn = 0.0, drawnAll = 0.0;
+  for (std::size_t g = 0; g < all.second.size(); ++g)
+  {
+    EXPECT_EQ(all.second[g].accepted, bounded.second[g].accepted);
+    EXPECT_EQ(all.second[g].boundSkipped, 0u);
+    skipped += bounded.second[g].boundSkipped;
+    later += bounded.second[g].boundSampledLater;
+    spared += bounded.second[g].boundSkippedSamples;
+    drawn += bounded.second[g].samples;
+    drawnAll += all.second[g].samples;
+  }
+  std::cout << "bound skipped " << skipped << " candidates, " << later << " sampled later; " << spared
+            << " of " << drawnAll << " samples spared\n";
+  EXPECT_GT(skipped, 100u);
+  EXPECT_GT(later, 0u);
+  EXPECT_GT(spared, 0.05 * drawnAll);
+  // Every sample is either drawn or spared.
+  EXPECT_NEAR(drawn + spared, drawnAll, 1e-6 * drawnAll);
 }
 
 TEST(MoRvGomea, SeededRunsGiveTheRecordedResults)

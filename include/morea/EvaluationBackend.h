@@ -8,6 +8,7 @@
 
 #include "morea/MeshRepair.h"
 #include "morea/ParallelStructure.h"
+#include "morea/RefusalBound.h"
 #include "morea/TetrahedronObjectives.h"
 
 #include <cstddef>
@@ -54,6 +55,10 @@ struct PartialCandidate
    *  between calls (the CUDA backend keeps them on the device and uploads
    *  only parents with keys it does not hold). 0: no such promise. */
   std::uint64_t parentKey{ 0 };
+  /** In and out: lets the backend skip sampling the candidate when its bound
+   *  is refused against the screen (EvaluationBackend::SetRefusalScreen);
+   *  null: always sampled. */
+  RefusalBound * bound{ nullptr };
 };
 
 /** How EvaluatePartials treats folds (SPEC 5). Each side of a candidate with
@@ -89,6 +94,12 @@ struct BackendStatistics
   /** CUDA only: candidates evaluated after their upload and fold checks had
    *  started early (StartNextPartials). */
   std::uint64_t startedCandidates{ 0 };
+  /** Candidates whose refusal bound spared their sampling, the samples they
+   *  would have drawn (not in `samples`), and those sampled later after all
+   *  (SampleSkipped: their samples are in `samples`). */
+  std::uint64_t boundSkipped{ 0 };
+  double        boundSkippedSamples{ 0.0 };
+  std::uint64_t boundSampledLater{ 0 };
   /** CUDA only: where the device time of the EvaluatePartials batches goes,
    *  between events on its stream. A phase in which the stream is empty
    *  counts the host's time: `betweenBatches` and `staging` are the device
@@ -206,6 +217,29 @@ public:
     return false;
   }
 
+  /** Samples candidates `which` of the current EvaluatePartials call that
+   *  their bound skipped (RefusalBound::skipped), completing their values
+   *  and clearing the flag; for the optimiser's exact check, when a bound
+   *  computed before the call no longer refuses one. Only from `ready`,
+   *  for candidates already handed over; synchronous. */
+  virtual void
+  SampleSkipped(const std::vector<PartialCandidate> & candidates, const std::vector<std::size_t> & which) = 0;
+
+  /** The archive and steering limit that bound the candidates of later
+   *  EvaluatePartials calls (those with PartialCandidate::bound set); set
+   *  anew before each call that uses it. Copied by the call. */
+  void
+  SetRefusalScreen(const RefusalScreen & screen)
+  {
+    m_RefusalScreen = screen;
+    m_HasRefusalScreen = true;
+  }
+  void
+  ClearRefusalScreen()
+  {
+    m_HasRefusalScreen = false;
+  }
+
   /** Fold checks and repair of later EvaluatePartials calls; the constraint
    *  and base mesh must outlive them. */
   virtual void
@@ -222,6 +256,8 @@ public:
 protected:
   BackendStatistics m_Statistics;
   FoldHandling      m_FoldHandling;
+  RefusalScreen     m_RefusalScreen;
+  bool              m_HasRefusalScreen{ false };
 };
 
 /** The seed of the repair of side `side` (0 source, 1 target) of a

@@ -56,6 +56,9 @@ struct GomeaOptions
   /** Host threads that sample candidates and check them for folds (0: one per
    *  hardware thread). The result does not depend on it. */
   std::size_t threads{ 0 };
+  /** Lets the backend skip sampling candidates that a bound shows refused
+   *  (RefusalBound.h). The result does not depend on it. */
+  bool boundRefusals{ true };
 
   /** ea_* keys, morea_repair_method and seed. */
   static GomeaOptions
@@ -99,6 +102,11 @@ struct GenerationRecord
    *  beyond it the device waited for the host. */
   double deviceSpanSeconds{ 0.0 };
   double samples{ 0.0 };
+  /** Candidates whose refusal bound spared their sampling (RefusalBound.h),
+   *  the samples spared, and those sampled later after all. */
+  std::size_t boundSkipped{ 0 };
+  double      boundSkippedSamples{ 0.0 };
+  std::size_t boundSampledLater{ 0 };
 };
 
 /** Per cluster and FOS element: what carries over between generations. */
@@ -230,6 +238,9 @@ private:
    *  archive without one). */
   bool
   Accepted(const Candidate & c, const Fitness & next, const Fitness & now, ArchiveVerdict * verdict) const;
+  /** How candidate `c` of solution `s` changes its totals, given its values. */
+  TetrahedronValues
+  CandidateChange(std::size_t s, const Candidate & c, const TetrahedronValues * values) const;
   void
   ForcedImprovement(std::size_t solution, int singleObjective, RandomGenerator & random, GenerationRecord & record);
   bool

@@ -63,6 +63,16 @@ public:
   TetrahedronValues
   Evaluate(std::size_t t, const Corners & source, const Corners & target) const;
 
+  /** What Evaluate() finds from the corners alone: magnitude, fold value,
+   *  folds and sample counts; intensity and guidance 0. */
+  TetrahedronValues
+  EvaluateCorners(std::size_t t, const Corners & source, const Corners & target) const;
+
+  /** Adds the sampled intensity and guidance sums to `values` (from
+   *  EvaluateCorners): Evaluate() is the two, with the same result. */
+  void
+  AddSampleSums(const Corners & source, const Corners & target, TetrahedronValues & values) const;
+
   /** Tetrahedron `t` of a whole solution. */
   TetrahedronValues
   Evaluate(std::size_t t, const DualMesh & solution) const;
@@ -94,7 +104,8 @@ public:
   }
 
 private:
-  /** Samples drawn in `from` (seeded by its coordinates), mapped to `to`;
+  /** Sums over the samples drawn in `from` (seeded by its coordinates),
+   *  mapped to `to`, added to `values`' intensity and guidance;
    *  `fromImage`/`toImage` are the images the two meshes live on. */
   void
   SampleDirection(const Corners & from, const Corners & to, const ChannelVolume & fromImage,

@@ -150,17 +150,30 @@ public:
       });
       m_Statistics.foldSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     }
+    // The corners' values first; a candidate whose bound is refused then
+    // goes without samples.
+    const RefusalScreen * screen = m_HasRefusalScreen ? &m_RefusalScreen : nullptr;
     m_Pool.ParallelFor(candidates.size(), [&](std::size_t i) {
       const PartialCandidate & c = candidates[i];
+      if (c.bound)
+        c.bound->skipped = false;
       if (skip[i])
         return;
-      Corners                  source, target;
-      const auto &             dependent = c.element->dependentTetrahedra;
+      Corners           source, target;
+      const auto &      dependent = c.element->dependentTetrahedra;
+      ObjectiveTotals   corners;
       for (std::size_t k = 0; k < dependent.size(); ++k)
       {
         CandidateCorners(c, tets[dependent[k]], source, target);
-        c.values[k] = m_Evaluator.Evaluate(dependent[k], source, target);
+        c.values[k] = m_Evaluator.EvaluateCorners(dependent[k], source, target);
+        corners.Add(c.values[k]);
       }
+      if (screen && c.bound && RefusedWhateverItsSamples(*c.bound, corners.sum, *screen))
+      {
+        c.bound->skipped = true;
+        return;
+      }
+      AddSampleSums(c);
     });
     ++m_Statistics.batches;
     for (std::size_t i = 0; i < candidates.size(); ++i)
@@ -169,15 +182,59 @@ public:
       if (skip[i])
         continue;
       m_Statistics.tetrahedra += c.element->dependentTetrahedra.size();
+      double samples = 0.0;
       for (std::size_t k = 0; k < c.element->dependentTetrahedra.size(); ++k)
-        m_Statistics.samples += c.values[k].samples;
+        samples += c.values[k].samples;
+      if (c.bound && c.bound->skipped)
+      {
+        ++m_Statistics.boundSkipped;
+        m_Statistics.boundSkippedSamples += samples;
+      }
+      else
+        m_Statistics.samples += samples;
     }
     m_Statistics.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (ready)
       ready(0, candidates.size());
   }
 
+  void
+  SampleSkipped(const std::vector<PartialCandidate> & candidates, const std::vector<std::size_t> & which) override
+  {
+    const auto start = std::chrono::steady_clock::now();
+    for (std::size_t i : which)
+      if (i >= candidates.size() || !candidates[i].bound || !candidates[i].bound->skipped)
+        throw Error("evaluation backend: only candidates the bound skipped can be sampled later");
+    m_Pool.ParallelFor(which.size(), [&](std::size_t w) { AddSampleSums(candidates[which[w]]); });
+    for (std::size_t i : which)
+    {
+      const PartialCandidate & c = candidates[i];
+      c.bound->skipped = false;
+      ++m_Statistics.boundSampledLater;
+      double samples = 0.0;
+      for (std::size_t k = 0; k < c.element->dependentTetrahedra.size(); ++k)
+        samples += c.values[k].samples;
+      m_Statistics.samples += samples;
+      m_Statistics.boundSkippedSamples -= samples;
+    }
+    m_Statistics.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+
 private:
+  /** Completes a candidate's values from EvaluateCorners with its samples. */
+  void
+  AddSampleSums(const PartialCandidate & c) const
+  {
+    const auto & tets = m_Evaluator.Topology().Tetrahedra();
+    const auto & dependent = c.element->dependentTetrahedra;
+    Corners      source, target;
+    for (std::size_t k = 0; k < dependent.size(); ++k)
+    {
+      CandidateCorners(c, tets[dependent[k]], source, target);
+      m_Evaluator.AddSampleSums(source, target, c.values[k]);
+    }
+  }
+
   void
   Count(const std::vector<TetrahedronValues> & values)
   {

@@ -3,6 +3,7 @@
 #include "morea/Error.h"
 #include "morea/MeshRepair.h"
 #include "morea/ParameterSet.h"
+#include "morea/RefusalBound.h"
 #include "morea/ThreadPool.h"
 
 #include <algorithm>
@@ -26,8 +27,6 @@ constexpr std::size_t KMeansIterations = 3;
 // Generations without improvement tolerated: 25 + the number of variables
 // (per distribution; per solution that of an edge element, 12).
 constexpr std::size_t NoImprovementStretchBase = 25;
-// A steering violation must rank before any fold: folds are the hard constraint.
-constexpr double FoldConstraintOffset = 1.0e12;
 double
 SecondsSince(std::chrono::steady_clock::time_point start)
 {
@@ -184,6 +183,7 @@ struct MoRvGomea::CandidateBatch
    *  (BuildPartials); `partialsBuilt` until ProcessCandidates uses them. */
   std::vector<PartialCandidate> partials;
   std::vector<CandidateFolds>   folds;
+  std::vector<RefusalBound>     bounds; ///< per candidate, when GomeaOptions::boundRefusals
   bool                          partialsBuilt{ false };
   /** AcceptCandidates' per-candidate working storage (see there). */
   struct Judged
@@ -194,6 +194,15 @@ struct MoRvGomea::CandidateBatch
     std::vector<std::uint32_t>     solution;
     std::vector<std::uint8_t>      guess; ///< the parallel pass's guess (refused for good, rejected, accepted)
     std::vector<std::size_t>       order, chainStart;
+    /** Per solution, the chain's state in the parallel pass. */
+    struct Chain
+    {
+      std::size_t     at{ 0 }; ///< the next candidate, in `order`
+      ObjectiveTotals held;    ///< the totals after the candidates accepted so far
+      Fitness         now;     ///< their fitness
+      std::uint64_t   witness{ 0 };
+    };
+    std::vector<Chain> chains;
 
     void
     Reserve(std::size_t count, std::size_t population)
@@ -209,6 +218,7 @@ struct MoRvGomea::CandidateBatch
         order.resize(count);
       }
       chainStart.assign(population + 1, 0);
+      chains.resize(population);
     }
   } judged;
 
@@ -290,15 +300,7 @@ MoRvGomea::~MoRvGomea() = default;
 Fitness
 MoRvGomea::Steered(const Fitness & raw) const
 {
-  Fitness f = raw;
-  if (!raw.feasible)
-    f.constraint = FoldConstraintOffset + raw.constraint;
-  else if (Value(raw.objectives, Objective::Guidance) > m_SteeringLimit)
-  {
-    f.feasible = false;
-    f.constraint = Value(raw.objectives, Objective::Guidance) - m_SteeringLimit;
-  }
-  return f;
+  return SteeredFitness(raw, m_SteeringLimit);
 }
 
 Fitness
@@ -729,6 +731,7 @@ MoRvGomea::BuildPartials(CandidateBatch & candidateBatch) const
   std::vector<PartialCandidate> & batch = candidateBatch.partials;
   batch.resize(candidates.size());
   candidateBatch.folds.assign(candidates.size(), CandidateFolds{});
+  candidateBatch.bounds.assign(m_Options.boundRefusals ? candidates.size() : 0, RefusalBound{});
   m_Pool->ParallelFor(candidates.size(), [&](std::size_t i) {
     const Candidate &  c = candidates[i];
     PartialCandidate & p = batch[i];
@@ -741,6 +744,7 @@ MoRvGomea::BuildPartials(CandidateBatch & candidateBatch) const
     p.folds = &candidateBatch.folds[i];
     p.seed = c.seed;
     p.evaluateFolded = true;
+    p.bound = m_Options.boundRefusals ? &candidateBatch.bounds[i] : nullptr;
   });
   candidateBatch.partialsBuilt = true;
 }
@@ -755,6 +759,19 @@ MoRvGomea::SetParentState(CandidateBatch & candidateBatch, std::size_t begin, st
     // points keep the donor's), so the key lets the backend keep parents.
     p.parentKey = std::max<std::uint64_t>(1, HashCombine(m_KeySalt, m_Ids[c.solution]));
     p.evaluateFolded = std::llround(m_Totals[c.solution].sum.folded) != 0;
+    if (!p.bound)
+      return;
+    // Other acceptance rules than the archive's are not bounded.
+    RefusalBound & bound = *p.bound;
+    bound.screened = !c.forced && c.singleObjective < 0;
+    bound.skipped = false;
+    if (!bound.screened)
+      return;
+    ObjectiveTotals rest = m_Totals[c.solution];
+    for (std::uint32_t t : p.element->dependentTetrahedra)
+      rest.Add(m_TetValues[c.solution][t], -1.0);
+    bound.rest = rest.sum;
+    bound.parent = CurrentFitness(c.solution);
   });
 }
 
@@ -806,6 +823,16 @@ MoRvGomea::ProcessCandidates(CandidateBatch & candidateBatch, GenerationRecord &
     meanwhile();
     meanwhileSeconds += SecondsSince(phaseStart);
   };
+  if (m_Options.boundRefusals)
+  {
+    RefusalScreen screen;
+    screen.archive = m_Archive->Objectives();
+    screen.tetrahedra = m_Topology.NumberOfTetrahedra();
+    screen.guidanceLimit = m_SteeringLimit;
+    m_Backend.SetRefusalScreen(screen);
+  }
+  else
+    m_Backend.ClearRefusalScreen();
   const auto evaluationStart = std::chrono::steady_clock::now();
   m_Backend.EvaluatePartials(batch, accept, meanwhile ? EvaluationBackend::Meanwhile(timedMeanwhile) : nullptr);
   const double foldSeconds = m_Backend.Statistics().foldSeconds - before.foldSeconds;
@@ -876,52 +903,74 @@ MoRvGomea::AcceptCandidates(CandidateBatch & candidateBatch, const std::vector<P
     for (std::size_t b = 0; b < count; ++b)
       j.order[fill[j.solution[b]]++] = b;
   }
-  m_Pool->ParallelFor(m_Population.size(), [&](std::size_t s) {
-    if (j.chainStart[s] == j.chainStart[s + 1])
-      return;
-    std::uint64_t   witness{ 0 };
-    ObjectiveTotals held = m_Totals[s]; // the chain's totals so far
-    Fitness         now = CurrentFitness(s);
-    for (std::size_t o = j.chainStart[s]; o < j.chainStart[s + 1]; ++o)
+  // A candidate whose bound spared its sampling (RefusalBound.h) has the
+  // bound for values: its fitness here is the bound's, and one the archive
+  // refuses is refused whatever its samples, as its guess says. Where the
+  // bound is not refused on the chain's totals so far (an earlier candidate
+  // of the chain was accepted), the chain stops there; the backend samples
+  // all stopped candidates at once and their chains go on.
+  const auto skipped = [&](std::size_t b) {
+    const RefusalBound * bound = batch[batchIndex[b]].bound;
+    return bound != nullptr && bound->skipped;
+  };
+  const auto runChain = [&](std::size_t s) {
+    CandidateBatch::Judged::Chain & chain = j.chains[s];
+    for (; chain.at < j.chainStart[s + 1]; ++chain.at)
     {
-      const std::size_t  b = j.order[o];
+      const std::size_t  b = j.order[chain.at];
       const Candidate &  c = candidates[batchIndex[b]];
-      const FosElement & element = m_Parallel.elements[c.element];
-      const auto &              stored = m_TetValues[s];
-      const TetrahedronValues * values = candidateBatch.Values(c);
-      ObjectiveTotals           change;
-      for (std::size_t k = 0; k < element.dependentTetrahedra.size(); ++k)
-      {
-        change.Add(stored[element.dependentTetrahedra[k]], -1.0);
-        change.Add(values[k]);
-      }
-      j.changes[b] = change.sum;
-      ObjectiveTotals totals = held;
+      j.changes[b] = CandidateChange(s, c, candidateBatch.Values(c));
+      ObjectiveTotals totals = chain.held;
       totals.Add(j.changes[b]);
       const Fitness next = Steered(totals.ToFitness(m_Topology.NumberOfTetrahedra()));
       j.next[b] = next;
-      j.now[b] = now;
+      j.now[b] = chain.now;
       j.verdicts[b] = ArchiveVerdict{};
       bool accept = false;
       if (c.forced || c.singleObjective >= 0)
-        accept = Accepted(c, next, now, nullptr);
+        accept = Accepted(c, next, chain.now, nullptr);
       else
       {
-        j.verdicts[b] = m_Archive->Judge(next, witness);
-        witness = j.verdicts[b].witness;
-        accept = ConstraintDominates(next, now) || j.verdicts[b].kind == ArchiveVerdict::Kind::Accepted;
+        j.verdicts[b] = m_Archive->Judge(next, chain.witness);
+        chain.witness = j.verdicts[b].witness;
+        accept = ConstraintDominates(next, chain.now) || j.verdicts[b].kind == ArchiveVerdict::Kind::Accepted;
       }
       const Guess guess = accept ? Guess::Accepted
                                  : (j.verdicts[b].kind == ArchiveVerdict::Kind::Rejected ? Guess::Refused
                                                                                          : Guess::Rejected);
+      if (guess != Guess::Refused && skipped(b))
+        return; // needs its samples
       j.guess[b] = static_cast<std::uint8_t>(guess);
       if (accept)
       {
-        held = totals;
-        now = next;
+        chain.held = totals;
+        chain.now = next;
       }
     }
-  });
+  };
+  std::vector<std::size_t> stopped;
+  for (std::size_t s = 0; s < m_Population.size(); ++s)
+    if (j.chainStart[s] < j.chainStart[s + 1])
+    {
+      j.chains[s] = CandidateBatch::Judged::Chain{ j.chainStart[s], m_Totals[s], CurrentFitness(s), 0 };
+      stopped.push_back(s);
+    }
+  std::vector<std::size_t> later;
+  while (!stopped.empty())
+  {
+    m_Pool->ParallelFor(stopped.size(), [&](std::size_t k) { runChain(stopped[k]); });
+    later.clear();
+    std::vector<std::size_t> still;
+    for (std::size_t s : stopped)
+      if (j.chains[s].at < j.chainStart[s + 1])
+      {
+        later.push_back(batchIndex[j.order[j.chains[s].at]]);
+        still.push_back(s);
+      }
+    if (!later.empty())
+      m_Backend.SampleSkipped(batch, later);
+    stopped.swap(still);
+  }
   // Chains whose guess the ordered pass overturned; their later candidates
   // are judged on the totals the solution then has.
   std::vector<bool>   overturned(m_Population.size(), false);
@@ -939,11 +988,25 @@ MoRvGomea::AcceptCandidates(CandidateBatch & candidateBatch, const std::vector<P
     const FosElement & element = m_Parallel.elements[c.element];
     ObjectiveTotals    totals = m_Totals[s];
     totals.Add(j.changes[b]);
+    bool sampledNow = false;
+    if (skipped(b))
+    {
+      // Its bound, judged afresh on the totals and archive of now.
+      const Fitness low = Steered(totals.ToFitness(m_Topology.NumberOfTetrahedra()));
+      if (!ConstraintDominates(low, CurrentFitness(s)) &&
+          m_Archive->Judge(low, j.verdicts[b].witness).kind == ArchiveVerdict::Kind::Rejected)
+        continue;
+      m_Backend.SampleSkipped(batch, { batchIndex[b] });
+      j.changes[b] = CandidateChange(s, c, candidateBatch.Values(c));
+      totals = m_Totals[s];
+      totals.Add(j.changes[b]);
+      sampledNow = true;
+    }
     ArchiveVerdict & verdict = j.verdicts[b];
     const Fitness *  now = &j.now[b];
     const Fitness *  next = &j.next[b];
     Fitness          current, fresh;
-    if (overturned[s])
+    if (overturned[s] || sampledNow)
     {
       current = CurrentFitness(s);
       fresh = Steered(totals.ToFitness(m_Topology.NumberOfTetrahedra()));
@@ -974,6 +1037,20 @@ MoRvGomea::AcceptCandidates(CandidateBatch & candidateBatch, const std::vector<P
     ++accepted;
   }
   return accepted;
+}
+
+TetrahedronValues
+MoRvGomea::CandidateChange(std::size_t s, const Candidate & c, const TetrahedronValues * values) const
+{
+  const FosElement & element = m_Parallel.elements[c.element];
+  const auto &       stored = m_TetValues[s];
+  ObjectiveTotals    change;
+  for (std::size_t k = 0; k < element.dependentTetrahedra.size(); ++k)
+  {
+    change.Add(stored[element.dependentTetrahedra[k]], -1.0);
+    change.Add(values[k]);
+  }
+  return change.sum;
 }
 
 bool
@@ -1248,6 +1325,9 @@ MoRvGomea::RunGeneration()
   summary.deviceKernelSeconds = m_Backend.Statistics().kernelSeconds - backendBefore.kernelSeconds;
   summary.deviceSpanSeconds = m_Backend.Statistics().BatchSpanSeconds() - backendBefore.BatchSpanSeconds();
   summary.samples = m_Backend.Statistics().samples - backendBefore.samples;
+  summary.boundSkipped = m_Backend.Statistics().boundSkipped - backendBefore.boundSkipped;
+  summary.boundSkippedSamples = m_Backend.Statistics().boundSkippedSamples - backendBefore.boundSkippedSamples;
+  summary.boundSampledLater = m_Backend.Statistics().boundSampledLater - backendBefore.boundSampledLater;
   m_History.push_back(summary);
 }
 

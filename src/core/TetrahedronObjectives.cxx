@@ -100,11 +100,10 @@ TetrahedronEvaluator::SampleDirection(const Corners & from, const Corners & to, 
   }
   values.intensity += intensity;
   values.guidance += guidance;
-  values.samples += static_cast<double>(n);
 }
 
 TetrahedronValues
-TetrahedronEvaluator::Evaluate(std::size_t t, const Corners & source, const Corners & target) const
+TetrahedronEvaluator::EvaluateCorners(std::size_t t, const Corners & source, const Corners & target) const
 {
   TetrahedronValues v;
   v.magnitude = TetrahedronMagnitude(source, target, m_Elasticity->empty() ? 1.0 : (*m_Elasticity)[t]);
@@ -114,8 +113,22 @@ TetrahedronEvaluator::Evaluate(std::size_t t, const Corners & source, const Corn
     v.foldValue += m_Constraint->TetrahedronViolation(t, (*c)[0], (*c)[1], (*c)[2], (*c)[3], folded);
     v.folded += folded ? 1.0 : 0.0;
   }
-  SampleDirection(source, target, m_Data->moving, m_Data->fixed, v);
-  SampleDirection(target, source, m_Data->fixed, m_Data->moving, v);
+  v.samples = static_cast<double>(SampleCount(source)) + static_cast<double>(SampleCount(target));
+  return v;
+}
+
+void
+TetrahedronEvaluator::AddSampleSums(const Corners & source, const Corners & target, TetrahedronValues & values) const
+{
+  SampleDirection(source, target, m_Data->moving, m_Data->fixed, values);
+  SampleDirection(target, source, m_Data->fixed, m_Data->moving, values);
+}
+
+TetrahedronValues
+TetrahedronEvaluator::Evaluate(std::size_t t, const Corners & source, const Corners & target) const
+{
+  TetrahedronValues v = EvaluateCorners(t, source, target);
+  AddSampleSums(source, target, v);
   return v;
 }
 

@@ -38,7 +38,7 @@ GatherCandidateCorners(CandidateBatch b, FoldedCandidateSkip skip, double * corn
     const std::uint8_t o = skip.outcome[2 * c + side];
     return (o & SideFolded) != 0 && (o & SideRepaired) == 0;
   };
-  const std::uint8_t skipped = skip.skipIfFolded && skip.skipIfFolded[c] && (leftFolded(0) || leftFolded(1)) ? 1 : 0;
+  const std::uint8_t skipped = skip.skipIfFolded && skip.skipIfFolded[c] && (leftFolded(0) || leftFolded(1)) ? ItemUnused : ItemSampled;
   for (std::size_t item = first + lane; item < end; item += 32)
   {
     const std::uint32_t t = dependent[item - first];

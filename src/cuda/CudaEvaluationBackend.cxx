@@ -9,6 +9,7 @@
 
 #include "DeviceMemory.h"
 #include "FoldRepairKernels.h"
+#include "RefusalScreenKernels.h"
 #include "TetrahedronKernels.h"
 
 #include "morea/ComputeDevices.h"
@@ -140,6 +141,7 @@ public:
     Check(cudaSetDevice(0), "selecting device 0");
     m_Stream = std::make_unique<cuda::Stream>();
     m_CopyStream = std::make_unique<cuda::Stream>();
+    m_FallbackStream = std::make_unique<cuda::Stream>(cuda::Stream::HighPriority{});
     m_FoldStart = std::make_unique<cuda::Event>();
     m_FoldEnd = std::make_unique<cuda::Event>();
     m_BatchStart = std::make_unique<cuda::Event>();
@@ -323,6 +325,7 @@ public:
       cuda::LaunchGatherCandidateCorners(m_Batch, items, skip, m_Corners.Data(), m_Tetrahedra.Data(),
                                          m_ItemSkip.Data(), m_Stream->Get());
     }
+    const bool screened = items > 0 && ScreenCandidates(candidates);
     // Each candidate's first item, as packed.
     const std::uint64_t * first = host.firstItem.Data();
     // Parts of whole candidates with about equal numbers of items, the last
@@ -360,11 +363,17 @@ public:
         foldsRead = true;
       }
       for (std::size_t i = candidateBounds[p]; i < candidateBounds[p + 1]; ++i)
+      {
         if (Skipped(candidates[i]))
           skippedItems += first[i + 1] - first[i];
+        if (candidates[i].bound)
+          candidates[i].bound->skipped = screened && m_HostScreenSkipped[i] != 0;
+      }
       UnpackRange(first, candidateBounds[p], candidateBounds[p + 1], [&](std::size_t i) -> TetrahedronValues * {
         return Skipped(candidates[i]) ? nullptr : candidates[i].values; // left alone, as on the CPU
       });
+      if (screened)
+        CountBoundSkipped(candidates, candidateBounds[p], candidateBounds[p + 1]);
       m_Statistics.unpackSeconds += SecondsSince(unpack);
       if (ready)
         ready(candidateBounds[p], candidateBounds[p + 1]);
@@ -413,7 +422,150 @@ public:
     m_Statistics.stagingSeconds += SecondsSince(start);
   }
 
+  void
+  SampleSkipped(const std::vector<PartialCandidate> & candidates, const std::vector<std::size_t> & which) override
+  {
+    const auto                 start = std::chrono::steady_clock::now();
+    const HostCandidates &     h = m_HostCandidates[m_CurrentHost];
+    std::size_t                count = 0;
+    for (std::size_t i : which)
+    {
+      if (i >= candidates.size() || !candidates[i].bound || !candidates[i].bound->skipped)
+        throw Error("evaluation backend: only candidates the bound skipped can be sampled later");
+      count += h.firstItem[i + 1] - h.firstItem[i];
+    }
+    if (count == 0)
+      return;
+    // The items' corners are still on the device, from the batch's gather:
+    // copied together and sampled on a stream of their own, whose blocks go
+    // before the later parts' sampling. The same kernels give the same sums.
+    cudaStream_t stream = m_FallbackStream->Get();
+    m_HostFallbackItems.Reserve(count);
+    std::size_t at = 0;
+    for (std::size_t i : which)
+      for (std::uint64_t item = h.firstItem[i]; item < h.firstItem[i + 1]; ++item)
+        m_HostFallbackItems[at++] = item;
+    m_FallbackItems.Reserve(count);
+    m_FallbackCorners.Reserve(count * cuda::ItemCorners);
+    m_FallbackTetrahedra.Reserve(count);
+    m_FallbackItemValues.Reserve(count * cuda::ItemValues);
+    m_FallbackDirectionValues.Reserve(count * 2 * cuda::DirectionValues);
+    m_HostFallbackDirectionValues.Reserve(count * 2 * cuda::DirectionValues);
+    Check(cudaMemcpyAsync(m_FallbackItems.Data(), m_HostFallbackItems.Data(), count * sizeof(std::uint64_t),
+                          cudaMemcpyHostToDevice, stream),
+          "copying skipped candidates to the device");
+    cuda::LaunchGatherItems(m_Corners.Data(), m_Tetrahedra.Data(), m_FallbackItems.Data(), count,
+                            m_FallbackCorners.Data(), m_FallbackTetrahedra.Data(), stream);
+    if (UsesTexturePath())
+    {
+      m_FallbackWorkspace.Reserve(cuda::TexturePrepareWorkspaceBytes(count));
+      m_HostFallbackChunks.Reserve(1);
+      cuda::LaunchPrepareTexture(m_Constants, m_FallbackCorners.Data(), m_FallbackTetrahedra.Data(), nullptr, count,
+                                 m_FallbackWorkspace.Data(), m_FallbackItemValues.Data(), m_HostFallbackChunks.Data(),
+                                 stream);
+      Check(cudaStreamSynchronize(stream), "preparing skipped candidates' sampling");
+      const std::size_t chunks = m_HostFallbackChunks[0];
+      m_FallbackChunkWorkspace.Reserve(std::max<std::size_t>(1, cuda::TextureChunkWorkspaceBytes(chunks)));
+      cuda::LaunchSampleTexture(m_Constants, count, m_FallbackWorkspace.Data(), chunks,
+                                m_FallbackChunkWorkspace.Data(), m_FallbackDirectionValues.Data(), stream);
+    }
+    else
+      cuda::LaunchEvaluateTetrahedra(m_Constants, m_FallbackCorners.Data(), m_FallbackTetrahedra.Data(), nullptr,
+                                     count, m_FallbackItemValues.Data(), m_FallbackDirectionValues.Data(), stream);
+    Check(cudaMemcpyAsync(m_HostFallbackDirectionValues.Data(), m_FallbackDirectionValues.Data(),
+                          count * 2 * cuda::DirectionValues * sizeof(double), cudaMemcpyDeviceToHost, stream),
+          "copying values from the device");
+    Check(cudaStreamSynchronize(stream), "sampling skipped candidates");
+    // Intensity and guidance as Unpack() adds them; the rest is the bound's.
+    at = 0;
+    for (std::size_t i : which)
+    {
+      const PartialCandidate & c = candidates[i];
+      double                   samples = 0.0;
+      for (std::size_t k = 0; k < c.element->dependentTetrahedra.size(); ++k, ++at)
+      {
+        const double * d = m_HostFallbackDirectionValues.Data() + at * 2 * cuda::DirectionValues;
+        c.values[k].intensity = d[0] + d[3];
+        c.values[k].guidance = d[1] + d[4];
+        samples += c.values[k].samples;
+      }
+      c.bound->skipped = false;
+      ++m_Statistics.boundSampledLater;
+      m_Statistics.samples += samples;
+      m_Statistics.boundSkippedSamples -= samples;
+    }
+    m_Statistics.seconds += SecondsSince(start);
+  }
+
 private:
+  /** Queues the refusal screen of a batch whose corners are queued, when
+   *  the optimiser set one and bounds some candidate; its outcome reaches
+   *  m_HostScreenSkipped before the first part's values. */
+  bool
+  ScreenCandidates(const std::vector<PartialCandidate> & candidates)
+  {
+    if (!m_HasRefusalScreen)
+      return false;
+    const std::size_t n = candidates.size();
+    if (std::none_of(candidates.begin(), candidates.end(),
+                     [](const PartialCandidate & c) { return c.bound && c.bound->screened; }))
+      return false;
+    m_HostBounds.Reserve(n);
+    m_Pool.ParallelFor(n, [&](std::size_t i) {
+      const PartialCandidate &  c = candidates[i];
+      cuda::CandidateBoundInput in{};
+      if (c.bound && c.bound->screened)
+      {
+        const TetrahedronValues & r = c.bound->rest;
+        const double              rest[6] = { r.magnitude, r.intensity, r.guidance, r.samples, r.foldValue, r.folded };
+        std::copy(rest, rest + 6, in.rest);
+        std::copy(c.bound->parent.objectives.begin(), c.bound->parent.objectives.end(), in.parent);
+        in.parentConstraint = c.bound->parent.constraint;
+        in.parentFeasible = c.bound->parent.feasible ? 1 : 0;
+        in.screened = 1;
+      }
+      m_HostBounds[i] = in;
+    });
+    const std::vector<ObjectiveVector> & archive = m_RefusalScreen.archive;
+    m_HostArchive.Reserve(std::max<std::size_t>(1, 3 * archive.size()));
+    for (std::size_t e = 0; e < archive.size(); ++e)
+      std::copy(archive[e].begin(), archive[e].end(), m_HostArchive.Data() + 3 * e);
+    cuda::RefusalScreenView view;
+    view.bounds = UploadAsync(m_HostBounds.Data(), n, m_Bounds);
+    view.archive = UploadAsync(m_HostArchive.Data(), 3 * archive.size(), m_Archive);
+    view.archiveSize = static_cast<std::uint32_t>(archive.size());
+    view.tetrahedra = static_cast<double>(m_RefusalScreen.tetrahedra);
+    view.guidanceLimit = m_RefusalScreen.guidanceLimit;
+    view.foldOffset = FoldConstraintOffset;
+    m_ScreenSkipped.Reserve(n);
+    m_HostScreenSkipped.Reserve(n);
+    cuda::LaunchScreenCandidates(m_Constants, m_Batch, m_Corners.Data(), m_Tetrahedra.Data(), view, m_ItemSkip.Data(),
+                                 m_ScreenSkipped.Data(), m_Stream->Get());
+    Check(cudaMemcpyAsync(m_HostScreenSkipped.Data(), m_ScreenSkipped.Data(), n, cudaMemcpyDeviceToHost,
+                          m_Stream->Get()),
+          "copying the refusal screen from the device");
+    return true;
+  }
+
+  /** Moves the samples of candidates [begin, end) that the bound skipped
+   *  from the drawn samples to the spared ones. */
+  void
+  CountBoundSkipped(const std::vector<PartialCandidate> & candidates, std::size_t begin, std::size_t end)
+  {
+    for (std::size_t i = begin; i < end; ++i)
+    {
+      const PartialCandidate & c = candidates[i];
+      if (!c.bound || !c.bound->skipped)
+        continue;
+      double samples = 0.0;
+      for (std::size_t k = 0; k < c.element->dependentTetrahedra.size(); ++k)
+        samples += c.values[k].samples;
+      ++m_Statistics.boundSkipped;
+      m_Statistics.boundSkippedSamples += samples;
+      m_Statistics.samples -= samples;
+    }
+  }
+
   /** Left folded by the checks and needing no values: not sampled. */
   static bool
   Skipped(const PartialCandidate & c)
@@ -1154,6 +1306,22 @@ private:
   cuda::DeviceArray<std::uint8_t>  m_ItemSkip; ///< per item of a batch: not sampled
   cuda::DeviceArray<std::uint64_t> m_SideSeedsDevice;
   cuda::PinnedArray<std::uint8_t>  m_HostSkipIfFolded, m_HostOutcome;
+  // The refusal screen (RefusalBound.h) per batch, and the sampling of the
+  // candidates it skipped that the optimiser needs after all.
+  cuda::PinnedArray<cuda::CandidateBoundInput> m_HostBounds;
+  cuda::DeviceArray<cuda::CandidateBoundInput> m_Bounds;
+  cuda::PinnedArray<double>                    m_HostArchive;
+  cuda::DeviceArray<double>                    m_Archive;
+  cuda::DeviceArray<std::uint8_t>              m_ScreenSkipped;
+  cuda::PinnedArray<std::uint8_t>              m_HostScreenSkipped;
+  std::unique_ptr<cuda::Stream>                m_FallbackStream;
+  cuda::PinnedArray<std::uint64_t>             m_HostFallbackItems;
+  cuda::DeviceArray<std::uint64_t>             m_FallbackItems;
+  cuda::DeviceArray<double> m_FallbackCorners, m_FallbackItemValues, m_FallbackDirectionValues;
+  cuda::DeviceArray<std::uint32_t>             m_FallbackTetrahedra;
+  cuda::DeviceArray<unsigned char>             m_FallbackWorkspace, m_FallbackChunkWorkspace;
+  cuda::PinnedArray<std::uint32_t>             m_HostFallbackChunks;
+  cuda::PinnedArray<double>                    m_HostFallbackDirectionValues;
 };
 } // namespace
 

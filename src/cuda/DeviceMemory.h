@@ -114,6 +114,16 @@ class Stream
 {
 public:
   Stream() { Check(cudaStreamCreateWithFlags(&m_Stream, cudaStreamNonBlocking), "creating a stream"); }
+  /** A stream whose blocks the device schedules before those of default
+   *  priority streams: for short work that others wait on. */
+  struct HighPriority
+  {};
+  explicit Stream(HighPriority)
+  {
+    int least = 0, greatest = 0;
+    Check(cudaDeviceGetStreamPriorityRange(&least, &greatest), "reading stream priorities");
+    Check(cudaStreamCreateWithPriority(&m_Stream, cudaStreamNonBlocking, greatest), "creating a stream");
+  }
   ~Stream()
   {
     if (m_Stream)

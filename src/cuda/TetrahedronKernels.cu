@@ -171,8 +171,11 @@ EvaluateTetrahedraKernel(EvaluationConstants k, View moving, View fixed, const d
 
   const double volume = fabs(SignedVolume(from));
   double       count = round(__ddiv_rn(__dmul_rn(k.samplingRate, volume), k.voxelVolume));
-  const bool          skipped = itemSkip != nullptr && itemSkip[item] != 0; // no samples: the values go unused
-  const std::uint32_t n = skipped ? 0u : (count < 1.0 ? 1u : static_cast<std::uint32_t>(count));
+  // Not sampled: an item whose values go unused gets no sample count either,
+  // one a refusal bound skipped keeps its count (ItemSkip).
+  const std::uint8_t  skip = itemSkip != nullptr ? itemSkip[item] : ItemSampled;
+  const std::uint32_t full = count < 1.0 ? 1u : static_cast<std::uint32_t>(count);
+  const std::uint32_t n = skip == ItemSampled ? full : 0u;
   std::uint32_t       shift[4];
   SobolShifts(TetrahedronSeed(from), shift);
 
@@ -235,7 +238,7 @@ EvaluateTetrahedraKernel(EvaluationConstants k, View moving, View fixed, const d
   double * out = directionOut + warp * DirectionValues;
   out[0] = intensity;
   out[1] = guidance;
-  out[2] = static_cast<double>(n);
+  out[2] = static_cast<double>(skip == ItemUnused ? 0u : full);
   if (direction == 0) // from = source, to = target
   {
     const std::uint32_t t = tetrahedra[item];

@@ -114,6 +114,17 @@ constexpr int DirectionValues = 3;
 /** Corners of one work item: source 4 x 3 then target 4 x 3 doubles. */
 constexpr int ItemCorners = 24;
 
+/** Per item of a batch (`itemSkip` bytes): sampled, or not sampled since its
+ *  values go unused (a candidate left folded: no sample counts either), or
+ *  not sampled since a refusal bound skipped its candidate (its sample
+ *  counts stay, its intensity and guidance sums are 0). */
+enum ItemSkip : std::uint8_t
+{
+  ItemSampled = 0,
+  ItemUnused = 1,
+  ItemBoundSkipped = 2
+};
+
 /** Copies the Sobol direction numbers (4 x 32) to the device; once per process. */
 void
 UploadSobolDirections(const std::uint32_t * directions);
@@ -131,9 +142,9 @@ struct FoldedCandidateSkip
 /** Writes the corners (items x ItemCorners) and tetrahedron index of every
  *  dependent tetrahedron of every candidate of `batch`, in candidate order:
  *  the parents' points with each element's points replaced, as
- *  CandidateCorners does on the host; `itemSkip` (items bytes) is 1 for the
- *  items of a candidate that `skip` leaves out, else 0. Asynchronous on
- *  `stream`. */
+ *  CandidateCorners does on the host; `itemSkip` (items bytes) is ItemUnused
+ *  for the items of a candidate that `skip` leaves out, else ItemSampled.
+ *  Asynchronous on `stream`. */
 void
 LaunchGatherCandidateCorners(const CandidateBatch & batch, std::size_t items, const FoldedCandidateSkip & skip,
                              double * corners, std::uint32_t * tetrahedra, std::uint8_t * itemSkip, void * stream);
@@ -148,8 +159,8 @@ LaunchScatterParents(const double * staged, const std::uint32_t * slots, std::si
 /** Evaluates `items` tetrahedra with the exact (software) interpolation:
  *  `corners` (items x 24 doubles) and `tetrahedra` (items indices) on the
  *  device; writes `itemOut` (items x ItemValues) and `directionOut`
- *  (items x 2 x DirectionValues). An item whose `itemSkip` byte is set (null:
- *  none) is not sampled: its direction values are 0, samples included.
+ *  (items x 2 x DirectionValues). Items are sampled as their `itemSkip`
+ *  byte says (null: all).
  *  Asynchronous on `stream` (a cudaStream_t); checks the launch. */
 void
 LaunchEvaluateTetrahedra(const EvaluationConstants & constants, const double * corners,
@@ -173,8 +184,7 @@ TexturePrepareWorkspaceBytes(std::size_t items);
 std::size_t
 TextureChunkWorkspaceBytes(std::size_t chunks);
 
-/** Step 1; an item whose `itemSkip` byte is set (null: none) gets no
- *  chunks, and step 2 gives it 0 samples. */
+/** Step 1; an item is sampled as its `itemSkip` byte says (null: all). */
 void
 LaunchPrepareTexture(const EvaluationConstants & constants, const double * corners, const std::uint32_t * tetrahedra,
                      const std::uint8_t * itemSkip, std::size_t items, void * workspace, double * itemOut, std::uint32_t * totalChunks,

@@ -236,17 +236,18 @@ PrepareTextureTasks(EvaluationConstants k, const double * __restrict__ corners,
     source[i] = c[i];
     target[i] = c[12 + i];
   }
-  // A skipped item (its values go unused) gets no samples, hence no chunks.
-  const bool skipped = itemSkip != nullptr && itemSkip[item] != 0;
-  SampleTask task;
+  // A skipped item gets no chunks; one whose values go unused no samples
+  // either, one a refusal bound skipped keeps its count (ItemSkip).
+  const std::uint8_t skip = itemSkip != nullptr ? itemSkip[item] : ItemSampled;
+  SampleTask         task;
   PrepareDirection(k, source, target, k.packedMoving, k.packedFixed, task);
-  task.samples = skipped ? 0u : task.samples;
+  task.samples = skip == ItemUnused ? 0u : task.samples;
   tasks[2 * item] = task;
-  chunkCounts[2 * item] = (task.samples + k.chunkSamples - 1) / k.chunkSamples;
+  chunkCounts[2 * item] = skip == ItemSampled ? (task.samples + k.chunkSamples - 1) / k.chunkSamples : 0u;
   PrepareDirection(k, target, source, k.packedFixed, k.packedMoving, task);
-  task.samples = skipped ? 0u : task.samples;
+  task.samples = skip == ItemUnused ? 0u : task.samples;
   tasks[2 * item + 1] = task;
-  chunkCounts[2 * item + 1] = (task.samples + k.chunkSamples - 1) / k.chunkSamples;
+  chunkCounts[2 * item + 1] = skip == ItemSampled ? (task.samples + k.chunkSamples - 1) / k.chunkSamples : 0u;
 
   itemIndex[item] = static_cast<std::uint32_t>(item);
 
