@@ -38,6 +38,9 @@ struct MeshRegistrationOptions
   std::size_t threads{ 0 }; ///< CPU backend threads (CUDA: host threads packing batches); 0: all
   /** Which evaluation backend: the CPU, CUDA, or CUDA when a device is present. */
   ::morea::BackendChoice backend{ ::morea::BackendChoice::Cpu };
+  /** Whether candidates that a bound shows refused go unsampled
+   *  (morea/RefusalBound.h); the result is the same either way. */
+  bool boundRefusals{ true };
   /** After each generation (also the resumed ones' replay is not called). May throw to abort. */
   std::function<void(const ::morea::GenerationRecord &, std::size_t generations)> onGeneration;
 };

@@ -329,6 +329,54 @@ TEST(CudaEvaluationBackend, SeededRunsReachFrontsOfTheSameQuality)
   EXPECT_NEAR(cudaGuidance, cpuGuidance, 0.25 * cpuGuidance);
 }
 
+TEST(CudaEvaluationBackend, RefusalBoundsChangeNoDecision)
+{
+  // The device screens each batch against its archive snapshot; candidates
+  // whose bound it refuses go unsampled, and those the optimiser's exact
+  // check needs are sampled later on a stream of their own. With the same
+  // seed a run must end exactly as one that samples every candidate.
+  MOREA_REQUIRE_CUDA_DEVICE();
+  OptimiserTestProblem problem;
+  const GomeaOptions   options = problem.Options(31, 12);
+  GomeaOptions         sampleAll = options;
+  sampleAll.boundRefusals = false;
+  for (const CudaInterpolation interpolation : { CudaInterpolation::Exact, CudaInterpolation::Texture })
+  {
+    auto       backend = CreateCudaEvaluationBackend(*problem.evaluator, 2, interpolation);
+    const auto run = [&](const GomeaOptions & o) {
+      MoRvGomea optimiser(problem.base, problem.topology, problem.parallel, *problem.constraint, *backend, o);
+      optimiser.Initialize(problem.InitialPopulation(o));
+      optimiser.Run();
+      return std::make_pair(optimiser.Archive().Entries(), optimiser.History());
+    };
+    const auto all = run(sampleAll);
+    const auto bounded = run(options);
+    ASSERT_EQ(all.first.size(), bounded.first.size()) << backend->Name();
+    for (std::size_t i = 0; i < all.first.size(); ++i)
+    {
+      EXPECT_EQ(all.first[i].id, bounded.first[i].id) << backend->Name();
+      EXPECT_EQ(all.first[i].fitness.objectives, bounded.first[i].fitness.objectives) << backend->Name();
+    }
+    std::size_t skipped = 0, later = 0;
+    double      spared = 0.0, drawn = 0.0, drawnAll = 0.0;
+    for (std::size_t g = 0; g < all.second.size(); ++g)
+    {
+      EXPECT_EQ(all.second[g].accepted, bounded.second[g].accepted) << backend->Name() << " generation " << g;
+      skipped += bounded.second[g].boundSkipped;
+      later += bounded.second[g].boundSampledLater;
+      spared += bounded.second[g].boundSkippedSamples;
+      drawn += bounded.second[g].samples;
+      drawnAll += all.second[g].samples;
+    }
+    std::cout << backend->Name() << ": bound skipped " << skipped << " candidates, " << later
+              << " sampled later; " << spared << " of " << drawnAll << " samples spared\n";
+    EXPECT_GT(skipped, 100u);
+    EXPECT_GT(later, 0u);
+    EXPECT_GT(spared, 0.05 * drawnAll);
+    EXPECT_NEAR(drawn + spared, drawnAll, 1e-6 * drawnAll);
+  }
+}
+
 TEST(CudaEvaluationBackend, TextureInterpolationStaysCloseToTheCpu)
 {
   MOREA_REQUIRE_CUDA_DEVICE();

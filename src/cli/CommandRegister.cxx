@@ -30,6 +30,7 @@ AddRegisterCommand(CLI::App & app)
     std::size_t      threads{ 0 };
     std::string      backend{ "auto" };
     std::size_t      killAfter{ 0 };
+    bool             sampleAll{ false };
   };
   auto   options = std::make_shared<Options>();
   auto * cmd = app.add_subcommand("register", "register a problem with MOREA and write the approximation set");
@@ -49,6 +50,9 @@ AddRegisterCommand(CLI::App & app)
                   "a device is present)")
     ->check(CLI::IsMember({ "cpu", "cuda", "cuda-texture", "auto" }))
     ->capture_default_str();
+  cmd->add_flag("--sample-all", options->sampleAll,
+                "sample every candidate, also those a lower bound of their objectives shows refused (slower, same "
+                "result; for comparisons)");
   // For crash-recovery tests: the process kills itself (SIGKILL) right after
   // generation N, as an external kill would, leaving only the checkpoint.
   cmd->add_option("--kill-after-generation", options->killAfter)->group("");
@@ -73,6 +77,7 @@ AddRegisterCommand(CLI::App & app)
     run.resume = options->resume;
     run.threads = options->threads;
     run.backend = ::morea::ParseBackendChoice(options->backend);
+    run.boundRefusals = !options->sampleAll;
     run.onGeneration = [print = ProgressPrinter(), killAfter = options->killAfter](
                          const ::morea::GenerationRecord & r, std::size_t total) {
       print(r, total);

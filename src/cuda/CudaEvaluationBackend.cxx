@@ -436,48 +436,81 @@ public:
     }
     if (count == 0)
       return;
-    // The items' corners are still on the device, from the batch's gather:
-    // copied together and sampled on a stream of their own, whose blocks go
-    // before the later parts' sampling. The same kernels give the same sums.
+    // The items' corners are still on the device, from the batch's gather.
+    // They are sampled on a stream of their own, whose blocks go before the
+    // later parts' sampling; the same arithmetic gives the same sums.
     cudaStream_t stream = m_FallbackStream->Get();
-    m_HostFallbackItems.Reserve(count);
-    std::size_t at = 0;
-    for (std::size_t i : which)
-      for (std::uint64_t item = h.firstItem[i]; item < h.firstItem[i + 1]; ++item)
-        m_HostFallbackItems[at++] = item;
-    m_FallbackItems.Reserve(count);
-    m_FallbackCorners.Reserve(count * cuda::ItemCorners);
-    m_FallbackTetrahedra.Reserve(count);
-    m_FallbackItemValues.Reserve(count * cuda::ItemValues);
-    m_FallbackDirectionValues.Reserve(count * 2 * cuda::DirectionValues);
     m_HostFallbackDirectionValues.Reserve(count * 2 * cuda::DirectionValues);
-    Check(cudaMemcpyAsync(m_FallbackItems.Data(), m_HostFallbackItems.Data(), count * sizeof(std::uint64_t),
-                          cudaMemcpyHostToDevice, stream),
-          "copying skipped candidates to the device");
-    cuda::LaunchGatherItems(m_Corners.Data(), m_Tetrahedra.Data(), m_FallbackItems.Data(), count,
-                            m_FallbackCorners.Data(), m_FallbackTetrahedra.Data(), stream);
     if (UsesTexturePath())
     {
-      m_FallbackWorkspace.Reserve(cuda::TexturePrepareWorkspaceBytes(count));
-      m_HostFallbackChunks.Reserve(1);
-      cuda::LaunchPrepareTexture(m_Constants, m_FallbackCorners.Data(), m_FallbackTetrahedra.Data(), nullptr, count,
-                                 m_FallbackWorkspace.Data(), m_FallbackItemValues.Data(), m_HostFallbackChunks.Data(),
-                                 stream);
-      Check(cudaStreamSynchronize(stream), "preparing skipped candidates' sampling");
-      const std::size_t chunks = m_HostFallbackChunks[0];
-      m_FallbackChunkWorkspace.Reserve(std::max<std::size_t>(1, cuda::TextureChunkWorkspaceBytes(chunks)));
-      cuda::LaunchSampleTexture(m_Constants, count, m_FallbackWorkspace.Data(), chunks,
-                                m_FallbackChunkWorkspace.Data(), m_FallbackDirectionValues.Data(), stream);
+      // Chunk by chunk, each set up in its warp: one kernel, no sort or scan.
+      // A direction's sample count is in the batch's values already.
+      const std::size_t chunkSamples = m_Constants.chunkSamples;
+      std::vector<std::uint32_t> list;
+      for (std::size_t i : which)
+        for (std::uint64_t item = h.firstItem[i]; item < h.firstItem[i + 1]; ++item)
+          for (std::uint32_t direction = 0; direction < 2; ++direction)
+          {
+            const double      n = m_HostDirectionValues[(2 * item + direction) * cuda::DirectionValues + 2];
+            const std::size_t chunks = (static_cast<std::size_t>(n) + chunkSamples - 1) / chunkSamples;
+            for (std::size_t local = 0; local < chunks; ++local)
+              list.insert(list.end(), { static_cast<std::uint32_t>(item), direction, static_cast<std::uint32_t>(local), 0u });
+          }
+      const std::size_t entries = list.size() / 4;
+      m_HostFallbackList.Reserve(std::max<std::size_t>(1, list.size()));
+      std::copy(list.begin(), list.end(), m_HostFallbackList.Data());
+      m_FallbackList.Reserve(std::max<std::size_t>(1, list.size()));
+      m_FallbackChunkSums.Reserve(std::max<std::size_t>(1, 2 * entries));
+      m_HostFallbackChunkSums.Reserve(std::max<std::size_t>(1, 2 * entries));
+      Check(cudaMemcpyAsync(m_FallbackList.Data(), m_HostFallbackList.Data(), list.size() * sizeof(std::uint32_t),
+                            cudaMemcpyHostToDevice, stream),
+            "copying skipped candidates to the device");
+      cuda::LaunchSampleListedChunks(m_Constants, m_Corners.Data(), m_FallbackList.Data(), entries,
+                                     m_FallbackChunkSums.Data(), stream);
+      Check(cudaMemcpyAsync(m_HostFallbackChunkSums.Data(), m_FallbackChunkSums.Data(), 2 * entries * sizeof(double),
+                            cudaMemcpyDeviceToHost, stream),
+            "copying values from the device");
+      Check(cudaStreamSynchronize(stream), "sampling skipped candidates");
+      // Each direction's chunks in order, as SumChunks adds them.
+      double * out = m_HostFallbackDirectionValues.Data();
+      for (std::size_t e = 0; e < entries; ++e)
+      {
+        if (e == 0 || list[4 * e] != list[4 * (e - 1)] || list[4 * e + 1] != list[4 * (e - 1) + 1])
+        {
+          if (e > 0)
+            out += cuda::DirectionValues;
+          out[0] = out[1] = 0.0;
+        }
+        out[0] += m_HostFallbackChunkSums[2 * e];
+        out[1] += m_HostFallbackChunkSums[2 * e + 1];
+      }
     }
     else
+    {
+      m_HostFallbackItems.Reserve(count);
+      std::size_t at = 0;
+      for (std::size_t i : which)
+        for (std::uint64_t item = h.firstItem[i]; item < h.firstItem[i + 1]; ++item)
+          m_HostFallbackItems[at++] = item;
+      m_FallbackItems.Reserve(count);
+      m_FallbackCorners.Reserve(count * cuda::ItemCorners);
+      m_FallbackTetrahedra.Reserve(count);
+      m_FallbackItemValues.Reserve(count * cuda::ItemValues);
+      m_FallbackDirectionValues.Reserve(count * 2 * cuda::DirectionValues);
+      Check(cudaMemcpyAsync(m_FallbackItems.Data(), m_HostFallbackItems.Data(), count * sizeof(std::uint64_t),
+                            cudaMemcpyHostToDevice, stream),
+            "copying skipped candidates to the device");
+      cuda::LaunchGatherItems(m_Corners.Data(), m_Tetrahedra.Data(), m_FallbackItems.Data(), count,
+                              m_FallbackCorners.Data(), m_FallbackTetrahedra.Data(), stream);
       cuda::LaunchEvaluateTetrahedra(m_Constants, m_FallbackCorners.Data(), m_FallbackTetrahedra.Data(), nullptr,
                                      count, m_FallbackItemValues.Data(), m_FallbackDirectionValues.Data(), stream);
-    Check(cudaMemcpyAsync(m_HostFallbackDirectionValues.Data(), m_FallbackDirectionValues.Data(),
-                          count * 2 * cuda::DirectionValues * sizeof(double), cudaMemcpyDeviceToHost, stream),
-          "copying values from the device");
-    Check(cudaStreamSynchronize(stream), "sampling skipped candidates");
+      Check(cudaMemcpyAsync(m_HostFallbackDirectionValues.Data(), m_FallbackDirectionValues.Data(),
+                            count * 2 * cuda::DirectionValues * sizeof(double), cudaMemcpyDeviceToHost, stream),
+            "copying values from the device");
+      Check(cudaStreamSynchronize(stream), "sampling skipped candidates");
+    }
     // Intensity and guidance as Unpack() adds them; the rest is the bound's.
-    at = 0;
+    std::size_t at = 0;
     for (std::size_t i : which)
     {
       const PartialCandidate & c = candidates[i];
@@ -1319,8 +1352,10 @@ private:
   cuda::DeviceArray<std::uint64_t>             m_FallbackItems;
   cuda::DeviceArray<double> m_FallbackCorners, m_FallbackItemValues, m_FallbackDirectionValues;
   cuda::DeviceArray<std::uint32_t>             m_FallbackTetrahedra;
-  cuda::DeviceArray<unsigned char>             m_FallbackWorkspace, m_FallbackChunkWorkspace;
-  cuda::PinnedArray<std::uint32_t>             m_HostFallbackChunks;
+  cuda::PinnedArray<std::uint32_t>             m_HostFallbackList;
+  cuda::DeviceArray<std::uint32_t>             m_FallbackList;
+  cuda::DeviceArray<double>                    m_FallbackChunkSums;
+  cuda::PinnedArray<double>                    m_HostFallbackChunkSums;
   cuda::PinnedArray<double>                    m_HostFallbackDirectionValues;
 };
 } // namespace

@@ -194,6 +194,16 @@ void
 LaunchSampleTexture(const EvaluationConstants & constants, std::size_t items, void * workspace, std::size_t chunks,
                     void * chunkWorkspace, double * directionOut, void * stream);
 
+/** Samples chunks of the texture path one by one: entry i of `list` (4
+ *  integers: item, direction, the chunk's place among the direction's
+ *  chunks, unused) names a chunk of an item whose corners `corners` holds
+ *  (items x ItemCorners); its intensity and guidance sums go to
+ *  chunkSums[2 i] and [2 i + 1], as step 2 computes them. A direction's value
+ *  is then the sum of its chunks' in order, from 0. Asynchronous on `stream`. */
+void
+LaunchSampleListedChunks(const EvaluationConstants & constants, const double * corners, const std::uint32_t * list,
+                         std::size_t entries, double * chunkSums, void * stream);
+
 /** Copies the Sobol direction numbers to the texture kernels' module. */
 void
 UploadTextureSobolDirections(const std::uint32_t * directions);

@@ -565,6 +565,50 @@ SampleTextureChunks(SamplingConstants k, const SampleTask * __restrict__ tasks,
     SampleChunk(k, b, first + 1, lane, corners[warp][1], chunkSums);
 }
 
+/** One warp per listed chunk (item, direction, the chunk's place among its
+ *  task's chunks) of items whose corners `corners` holds: the task is set
+ *  up in the warp as step 1 sets it up, and the chunk sampled as in
+ *  SampleTextureChunks, so its sums are those the schedule gives it. For a
+ *  few candidates' items at a time, without step 1's sort and scan. */
+__global__ void __launch_bounds__(SampleWarpsPerBlock * 32)
+SampleListedChunks(SamplingConstants s, EvaluationConstants k, const double * __restrict__ corners,
+                   const uint4 * __restrict__ list, std::size_t entries, double2 * chunkSums)
+{
+  __shared__ SampleTask tasks[SampleWarpsPerBlock];
+  __shared__ float4     taskCorners[SampleWarpsPerBlock][6];
+  const int             warp = static_cast<int>(threadIdx.x / 32), lane = static_cast<int>(threadIdx.x & 31);
+  const std::size_t     entry = (static_cast<std::size_t>(blockIdx.x) * blockDim.x + threadIdx.x) / 32;
+  if (entry >= entries) // whole warps leave together
+    return;
+  const uint4 e = list[entry];
+  if (lane == 0)
+  {
+    double         source[12], target[12];
+    const double * c = corners + static_cast<std::size_t>(e.x) * ItemCorners;
+    for (int i = 0; i < 12; ++i)
+    {
+      source[i] = c[i];
+      target[i] = c[12 + i];
+    }
+    if (e.y == 0)
+      PrepareDirection(k, source, target, k.packedMoving, k.packedFixed, tasks[warp]);
+    else
+      PrepareDirection(k, target, source, k.packedFixed, k.packedMoving, tasks[warp]);
+  }
+  __syncwarp();
+  const SampleTask & task = tasks[warp];
+  if (lane < 6)
+    taskCorners[warp][lane] = reinterpret_cast<const float4 *>(&task)[lane];
+  ChunkHeader h;
+  h.task = e.y;
+  h.local = e.z;
+  h.n = task.samples;
+  h.near = task.nearContour != 0;
+  h.shift = make_uint4(task.shift[0], task.shift[1], task.shift[2], task.shift[3]);
+  __syncwarp();
+  SampleChunk(s, h, entry, lane, taskCorners[warp], chunkSums);
+}
+
 /** Each direction's chunk sums in chunk order: the result does not depend on
  *  how the warps were scheduled. */
 __global__ void
@@ -587,6 +631,30 @@ SumChunks(const SampleTask * __restrict__ tasks, const std::uint32_t * __restric
   out[0] = intensity;
   out[1] = guidance;
   out[2] = static_cast<double>(tasks[task].samples);
+}
+SamplingConstants
+SamplingConstantsOf(const EvaluationConstants & constants)
+{
+  SamplingConstants k;
+  k.movingIntensity = static_cast<cudaTextureObject_t>(constants.packedMoving.intensityTexture);
+  k.fixedIntensity = static_cast<cudaTextureObject_t>(constants.packedFixed.intensityTexture);
+  k.movingDistance = static_cast<cudaTextureObject_t>(constants.packedMoving.distanceTexture);
+  k.fixedDistance = static_cast<cudaTextureObject_t>(constants.packedFixed.distanceTexture);
+  k.movingNearBlocks = constants.packedMoving.nearBlocks;
+  k.fixedNearBlocks = constants.packedFixed.nearBlocks;
+  for (int a = 0; a < 3; ++a)
+  {
+    k.movingBlocks[a] = constants.packedMoving.blocks[a];
+    k.fixedBlocks[a] = constants.packedFixed.blocks[a];
+  }
+  k.distanceChannels = constants.packedMoving.distanceChannels;
+  for (int g = 0; g < 3; ++g)
+    k.guidanceWeights[g] = constants.textureGuidanceWeights[g];
+  k.radius = static_cast<float>(constants.guidanceRadius);
+  k.inverseRadius = static_cast<float>(1.0 / constants.guidanceRadius);
+  k.structures = constants.structures;
+  k.chunkIterations = constants.chunkSamples / 32;
+  return k;
 }
 } // namespace
 
@@ -714,25 +782,7 @@ LaunchSampleTexture(const EvaluationConstants & constants, std::size_t items, vo
                                                w.taskFirstChunk, chunkTask);
   Check(cudaGetLastError(), "launching the chunk scatter kernel");
 
-  SamplingConstants k;
-  k.movingIntensity = static_cast<cudaTextureObject_t>(constants.packedMoving.intensityTexture);
-  k.fixedIntensity = static_cast<cudaTextureObject_t>(constants.packedFixed.intensityTexture);
-  k.movingDistance = static_cast<cudaTextureObject_t>(constants.packedMoving.distanceTexture);
-  k.fixedDistance = static_cast<cudaTextureObject_t>(constants.packedFixed.distanceTexture);
-  k.movingNearBlocks = constants.packedMoving.nearBlocks;
-  k.fixedNearBlocks = constants.packedFixed.nearBlocks;
-  for (int a = 0; a < 3; ++a)
-  {
-    k.movingBlocks[a] = constants.packedMoving.blocks[a];
-    k.fixedBlocks[a] = constants.packedFixed.blocks[a];
-  }
-  k.distanceChannels = constants.packedMoving.distanceChannels;
-  for (int g = 0; g < 3; ++g)
-    k.guidanceWeights[g] = constants.textureGuidanceWeights[g];
-  k.radius = static_cast<float>(constants.guidanceRadius);
-  k.inverseRadius = static_cast<float>(1.0 / constants.guidanceRadius);
-  k.structures = constants.structures;
-  k.chunkIterations = constants.chunkSamples / 32;
+  const SamplingConstants k = SamplingConstantsOf(constants);
   if (chunks > 0)
   {
     const std::size_t warps = (chunks + 1) / 2;
@@ -743,5 +793,17 @@ LaunchSampleTexture(const EvaluationConstants & constants, std::size_t items, vo
   }
   SumChunks<<<taskBlocks, 256, 0, s>>>(w.tasks, w.chunkCounts, w.taskFirstChunk, chunkSums, tasks, directionOut);
   Check(cudaGetLastError(), "launching the chunk sum kernel");
+}
+void
+LaunchSampleListedChunks(const EvaluationConstants & constants, const double * corners, const std::uint32_t * list,
+                         std::size_t entries, double * chunkSums, void * stream)
+{
+  if (entries == 0)
+    return;
+  const unsigned blocks = static_cast<unsigned>((entries + SampleWarpsPerBlock - 1) / SampleWarpsPerBlock);
+  SampleListedChunks<<<blocks, SampleWarpsPerBlock * 32, 0, static_cast<cudaStream_t>(stream)>>>(
+    SamplingConstantsOf(constants), constants, corners, reinterpret_cast<const uint4 *>(list), entries,
+    reinterpret_cast<double2 *>(chunkSums));
+  Check(cudaGetLastError(), "launching the listed chunks' sampling");
 }
 } // namespace morea::cuda

@@ -35,7 +35,8 @@ RegisterMeshes(const RegistrationProblem & problem, const ::morea::ParameterSet 
   result.secondsModel = std::chrono::duration<double>(Clock::now() - start).count();
 
   start = Clock::now();
-  const ::morea::GomeaOptions gomea = ::morea::GomeaOptions::FromParameters(parameters);
+  ::morea::GomeaOptions gomea = ::morea::GomeaOptions::FromParameters(parameters);
+  gomea.boundRefusals = options.boundRefusals;
   ::morea::MoRvGomea optimiser(model.base, model.topology, model.parallel, constraint, *backend, gomea);
   if (options.resume && !options.checkpointPath.empty() && std::filesystem::exists(options.checkpointPath))
   {
