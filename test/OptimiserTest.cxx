@@ -14,6 +14,7 @@
 #include <iomanip>
 #include <iostream>
 #include <iterator>
+#include <numeric>
 #include <random>
 #include <sstream>
 #include <utility>
@@ -47,10 +48,19 @@ public:
   EvaluatePartials(const std::vector<PartialCandidate> & candidates, const ReadyCandidates & ready,
                    const Meanwhile & meanwhile) override
   {
-    std::vector<PartialCandidate> shuffled = candidates;
-    std::shuffle(shuffled.begin(), shuffled.end(), m_Random);
+    std::vector<std::size_t> order(candidates.size());
+    std::iota(order.begin(), order.end(), std::size_t{ 0 });
+    std::shuffle(order.begin(), order.end(), m_Random);
+    std::vector<PartialCandidate> shuffled;
+    for (std::size_t i : order)
+      shuffled.push_back(candidates[i]);
     if (m_HasRefusalScreen)
-      m_Cpu->SetRefusalScreen(m_RefusalScreen);
+    {
+      // Bounds are filled by the caller's candidate numbers.
+      RefusalScreen screen = m_RefusalScreen;
+      screen.fill = [fill = m_RefusalScreen.fill, order](std::size_t i) { fill(order[i]); };
+      m_Cpu->SetRefusalScreen(screen);
+    }
     else
       m_Cpu->ClearRefusalScreen();
     m_Cpu->EvaluatePartials(shuffled);

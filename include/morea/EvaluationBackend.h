@@ -100,6 +100,8 @@ struct BackendStatistics
   std::uint64_t boundSkipped{ 0 };
   double        boundSkippedSamples{ 0.0 };
   std::uint64_t boundSampledLater{ 0 };
+  std::uint64_t boundSampleLaterCalls{ 0 }; ///< SampleSkipped calls
+  double        boundSampleLaterSeconds{ 0.0 }; ///< wall time inside them
   /** CUDA only: where the device time of the EvaluatePartials batches goes,
    *  between events on its stream. A phase in which the stream is empty
    *  counts the host's time: `betweenBatches` and `staging` are the device

@@ -92,6 +92,7 @@ struct GenerationRecord
     double forcedImprovements{ 0.0 }; ///< all of it, its own phases included
     double modelling{ 0.0 };   ///< steering, selection, clustering and estimation
     double bookkeeping{ 0.0 }; ///< multipliers, periodic full evaluation and the summary
+    double parentState{ 0.0 }; ///< parents' keys and refusal bounds before each batch's evaluation
   } phaseSeconds;
   /** The backend's device time in this generation (the evaluation kernels;
    *  0 on the CPU backend) and its sample points, both directions: the
@@ -107,6 +108,8 @@ struct GenerationRecord
   std::size_t boundSkipped{ 0 };
   double      boundSkippedSamples{ 0.0 };
   std::size_t boundSampledLater{ 0 };
+  std::size_t boundSampleLaterCalls{ 0 };
+  double      boundSampleLaterSeconds{ 0.0 };
 };
 
 /** Per cluster and FOS element: what carries over between generations. */
@@ -238,6 +241,9 @@ private:
    *  archive without one). */
   bool
   Accepted(const Candidate & c, const Fitness & next, const Fitness & now, ArchiveVerdict * verdict) const;
+  /** Candidate i's refusal bound from its parent's state (RefusalScreen::fill). */
+  void
+  FillBound(CandidateBatch & candidateBatch, std::size_t i) const;
   /** How candidate `c` of solution `s` changes its totals, given its values. */
   TetrahedronValues
   CandidateChange(std::size_t s, const Candidate & c, const TetrahedronValues * values) const;

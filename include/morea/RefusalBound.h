@@ -19,6 +19,7 @@
 #include "morea/TetrahedronObjectives.h"
 
 #include <cstddef>
+#include <functional>
 #include <vector>
 
 namespace morea
@@ -56,6 +57,12 @@ struct RefusalScreen
   std::vector<ObjectiveVector> archive;
   std::size_t                  tetrahedra{ 0 };
   double                       guidanceLimit{ 0.0 };
+  /** Fills the bound of candidate i of the EvaluatePartials call from its
+   *  parent's state. Called by the backend for each candidate with a bound,
+   *  from several threads at once, before screening it: where the backend
+   *  has other work under way (a GPU checking folds), this host work
+   *  overlaps it. */
+  std::function<void(std::size_t)> fill;
 };
 
 /** The lower bound's fitness: `rest` plus `corners`, the new tetrahedra's

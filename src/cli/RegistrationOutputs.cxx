@@ -126,7 +126,8 @@ WriteRegistrationOutputs(const itk::morea::PreprocessResult & preprocessed,
   log << "generation,hypervolume,best_guidance,archive_size,feasible,candidates,folded,accepted,repaired,forced_improvements,"
          "mean_multiplier,tetrahedron_evaluations,seconds,seconds_sampling,seconds_fold_checks,seconds_evaluation,"
          "seconds_acceptance,seconds_forced_improvements,seconds_modelling,seconds_bookkeeping,seconds_device_kernels,"
-         "seconds_device_span,samples,bound_skipped,bound_skipped_samples,bound_sampled_later\n";
+         "seconds_device_span,samples,bound_skipped,bound_skipped_samples,bound_sampled_later,"
+         "bound_sample_later_calls,seconds_bound_sample_later,seconds_parent_state\n";
   for (const auto & r : result.history)
     log << r.generation << "," << r.hypervolume << "," << r.bestGuidance << "," << r.archiveSize << "," << r.feasible
         << "," << r.candidates << "," << r.folded << "," << r.accepted << "," << r.repaired << "," << r.forcedImprovements << "," << r.meanMultiplier << ","
@@ -134,7 +135,8 @@ WriteRegistrationOutputs(const itk::morea::PreprocessResult & preprocessed,
         << r.phaseSeconds.foldChecks << "," << r.phaseSeconds.evaluation << "," << r.phaseSeconds.acceptance << ","
         << r.phaseSeconds.forcedImprovements << "," << r.phaseSeconds.modelling << "," << r.phaseSeconds.bookkeeping
         << "," << r.deviceKernelSeconds << "," << r.deviceSpanSeconds << "," << r.samples << "," << r.boundSkipped
-        << "," << r.boundSkippedSamples << "," << r.boundSampledLater << "\n";
+        << "," << r.boundSkippedSamples << "," << r.boundSampledLater << "," << r.boundSampleLaterCalls << ","
+        << r.boundSampleLaterSeconds << "," << r.phaseSeconds.parentState << "\n";
   WriteTextFile(log.str(), out + "generations.csv");
 
   // The chosen solutions.

@@ -168,6 +168,8 @@ public:
         c.values[k] = m_Evaluator.EvaluateCorners(dependent[k], source, target);
         corners.Add(c.values[k]);
       }
+      if (screen && c.bound && screen->fill)
+        screen->fill(i);
       if (screen && c.bound && RefusedWhateverItsSamples(*c.bound, corners.sum, *screen))
       {
         c.bound->skipped = true;
@@ -217,7 +219,10 @@ public:
       m_Statistics.samples += samples;
       m_Statistics.boundSkippedSamples -= samples;
     }
-    m_Statistics.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    m_Statistics.seconds += seconds;
+    m_Statistics.boundSampleLaterSeconds += seconds;
+    ++m_Statistics.boundSampleLaterCalls;
   }
 
 private:

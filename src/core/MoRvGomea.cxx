@@ -759,20 +759,25 @@ MoRvGomea::SetParentState(CandidateBatch & candidateBatch, std::size_t begin, st
     // points keep the donor's), so the key lets the backend keep parents.
     p.parentKey = std::max<std::uint64_t>(1, HashCombine(m_KeySalt, m_Ids[c.solution]));
     p.evaluateFolded = std::llround(m_Totals[c.solution].sum.folded) != 0;
-    if (!p.bound)
-      return;
-    // Other acceptance rules than the archive's are not bounded.
-    RefusalBound & bound = *p.bound;
-    bound.screened = !c.forced && c.singleObjective < 0;
-    bound.skipped = false;
-    if (!bound.screened)
-      return;
-    ObjectiveTotals rest = m_Totals[c.solution];
-    for (std::uint32_t t : p.element->dependentTetrahedra)
-      rest.Add(m_TetValues[c.solution][t], -1.0);
-    bound.rest = rest.sum;
-    bound.parent = CurrentFitness(c.solution);
+    if (p.bound)
+      p.bound->skipped = false;
   });
+}
+
+void
+MoRvGomea::FillBound(CandidateBatch & candidateBatch, std::size_t i) const
+{
+  const Candidate &  c = candidateBatch.candidates[i];
+  RefusalBound &     bound = candidateBatch.bounds[i];
+  // Other acceptance rules than the archive's are not bounded.
+  bound.screened = !c.forced && c.singleObjective < 0;
+  if (!bound.screened)
+    return;
+  ObjectiveTotals rest = m_Totals[c.solution];
+  for (std::uint32_t t : m_Parallel.elements[c.element].dependentTetrahedra)
+    rest.Add(m_TetValues[c.solution][t], -1.0);
+  bound.rest = rest.sum;
+  bound.parent = CurrentFitness(c.solution);
 }
 
 std::size_t
@@ -791,7 +796,9 @@ MoRvGomea::ProcessCandidates(CandidateBatch & candidateBatch, GenerationRecord &
   std::vector<PartialCandidate> &    batch = candidateBatch.partials;
   const std::vector<CandidateFolds> & folds = candidateBatch.folds;
   // In parallel: the device waits for this (a batch holds tens of thousands).
+  const auto parentStart = std::chrono::steady_clock::now();
   SetParentState(candidateBatch, 0, candidates.size());
+  record.phaseSeconds.parentState += SecondsSince(parentStart);
   // 2. Acceptance of each part of the batch as the backend hands it over
   //    (in order), while the device may still compute the next part.
   std::size_t       accepted = 0;
@@ -829,6 +836,7 @@ MoRvGomea::ProcessCandidates(CandidateBatch & candidateBatch, GenerationRecord &
     screen.archive = m_Archive->Objectives();
     screen.tetrahedra = m_Topology.NumberOfTetrahedra();
     screen.guidanceLimit = m_SteeringLimit;
+    screen.fill = [this, &candidateBatch](std::size_t i) { FillBound(candidateBatch, i); };
     m_Backend.SetRefusalScreen(screen);
   }
   else
@@ -1328,6 +1336,9 @@ MoRvGomea::RunGeneration()
   summary.boundSkipped = m_Backend.Statistics().boundSkipped - backendBefore.boundSkipped;
   summary.boundSkippedSamples = m_Backend.Statistics().boundSkippedSamples - backendBefore.boundSkippedSamples;
   summary.boundSampledLater = m_Backend.Statistics().boundSampledLater - backendBefore.boundSampledLater;
+  summary.boundSampleLaterCalls = m_Backend.Statistics().boundSampleLaterCalls - backendBefore.boundSampleLaterCalls;
+  summary.boundSampleLaterSeconds =
+    m_Backend.Statistics().boundSampleLaterSeconds - backendBefore.boundSampleLaterSeconds;
   m_History.push_back(summary);
 }
 

@@ -20,6 +20,7 @@
 #include "morea/ThreadPool.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <functional>
@@ -528,6 +529,8 @@ public:
       m_Statistics.boundSkippedSamples -= samples;
     }
     m_Statistics.seconds += SecondsSince(start);
+    m_Statistics.boundSampleLaterSeconds += SecondsSince(start);
+    ++m_Statistics.boundSampleLaterCalls;
   }
 
 private:
@@ -540,13 +543,16 @@ private:
     if (!m_HasRefusalScreen)
       return false;
     const std::size_t n = candidates.size();
-    if (std::none_of(candidates.begin(), candidates.end(),
-                     [](const PartialCandidate & c) { return c.bound && c.bound->screened; }))
+    if (std::none_of(candidates.begin(), candidates.end(), [](const PartialCandidate & c) { return c.bound; }))
       return false;
+    // The bounds are filled here, while the device checks folds.
     m_HostBounds.Reserve(n);
+    std::atomic<bool> any{ false };
     m_Pool.ParallelFor(n, [&](std::size_t i) {
       const PartialCandidate &  c = candidates[i];
       cuda::CandidateBoundInput in{};
+      if (c.bound && m_RefusalScreen.fill)
+        m_RefusalScreen.fill(i);
       if (c.bound && c.bound->screened)
       {
         const TetrahedronValues & r = c.bound->rest;
@@ -556,9 +562,12 @@ private:
         in.parentConstraint = c.bound->parent.constraint;
         in.parentFeasible = c.bound->parent.feasible ? 1 : 0;
         in.screened = 1;
+        any.store(true, std::memory_order_relaxed);
       }
       m_HostBounds[i] = in;
     });
+    if (!any.load())
+      return false;
     const std::vector<ObjectiveVector> & archive = m_RefusalScreen.archive;
     m_HostArchive.Reserve(std::max<std::size_t>(1, 3 * archive.size()));
     for (std::size_t e = 0; e < archive.size(); ++e)
