@@ -40,7 +40,7 @@ struct MeshRegistrationOptions
   ::morea::BackendChoice backend{ ::morea::BackendChoice::Cpu };
   /** Whether candidates that a bound shows refused go unsampled
    *  (morea/RefusalBound.h); the result is the same either way. */
-  bool boundRefusals{ true };
+  ::morea::RefusalBoundChoice refusalBounds{ ::morea::RefusalBoundChoice::Auto };
   /** After each generation (also the resumed ones' replay is not called). May throw to abort. */
   std::function<void(const ::morea::GenerationRecord &, std::size_t generations)> onGeneration;
 };

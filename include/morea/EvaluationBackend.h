@@ -227,6 +227,15 @@ public:
   virtual void
   SampleSkipped(const std::vector<PartialCandidate> & candidates, const std::vector<std::size_t> & which) = 0;
 
+  /** Whether skipping candidates by their refusal bound makes runs faster
+   *  here (RefusalBoundChoice::Auto): true where sampling is the work that
+   *  limits a generation. */
+  virtual bool
+  GainsFromRefusalBounds() const
+  {
+    return true;
+  }
+
   /** The archive and steering limit that bound the candidates of later
    *  EvaluatePartials calls (those with PartialCandidate::bound set); set
    *  anew before each call that uses it. Copied by the call. */
@@ -306,6 +315,13 @@ ParseBackendChoice(const std::string & name);
 /** The one place that picks the platform. */
 std::unique_ptr<EvaluationBackend>
 CreateEvaluationBackend(BackendChoice choice, const TetrahedronEvaluator & evaluator, std::size_t threads = 0);
+
+/** Whether a run on `backend` skips candidates by their bound. */
+inline bool
+UsesRefusalBounds(RefusalBoundChoice choice, const EvaluationBackend & backend)
+{
+  return choice == RefusalBoundChoice::On || (choice == RefusalBoundChoice::Auto && backend.GainsFromRefusalBounds());
+}
 
 /** Corners of tetrahedron `t` on one side of a mesh whose points `moved` are
  *  replaced by `replacements` (one per moved point, in the same order). */

@@ -20,6 +20,7 @@
 
 #include <cstddef>
 #include <functional>
+#include <string>
 #include <vector>
 
 namespace morea
@@ -64,6 +65,18 @@ struct RefusalScreen
    *  overlaps it. */
   std::function<void(std::size_t)> fill;
 };
+
+/** Whether a run lets its backend skip candidates by their bound. */
+enum class RefusalBoundChoice
+{
+  Auto, ///< where the backend gains from it (EvaluationBackend::GainsFromRefusalBounds)
+  On,
+  Off
+};
+
+/** "auto", "on" or "off"; anything else is an error. */
+RefusalBoundChoice
+ParseRefusalBoundChoice(const std::string & name);
 
 /** The lower bound's fitness: `rest` plus `corners`, the new tetrahedra's
  *  values without their intensity and guidance. */

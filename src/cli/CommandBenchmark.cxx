@@ -40,12 +40,13 @@ Since(Clock::time_point start)
  *  from a checkpoint of `morea register` (late generations). */
 nlohmann::json
 TimeBackend(const std::string & name, const itk::morea::MeshModel & model, const TetrahedronEvaluator & evaluator,
-            const GomeaOptions & gomea, const InitialPopulationOptions & initial, std::size_t generations,
-            std::size_t threads, const std::string & checkpoint)
+            GomeaOptions gomea, const InitialPopulationOptions & initial, std::size_t generations,
+            std::size_t threads, const std::string & checkpoint, RefusalBoundChoice refusalBounds)
 {
   const std::size_t memoryBefore = CudaMemoryInUse();
   std::size_t       memoryPeak = memoryBefore;
   auto              backend = CreateEvaluationBackend(ParseBackendChoice(name), evaluator, threads);
+  gomea.boundRefusals = UsesRefusalBounds(refusalBounds, *backend);
   std::cout << "  backend " << backend->Name() << ": initial population of " << gomea.populationSize << "\n"
             << std::flush;
   auto      start = Clock::now();
@@ -99,6 +100,7 @@ TimeBackend(const std::string & name, const itk::morea::MeshModel & model, const
                                   { "unpacking", after.unpackSeconds - before.unpackSeconds } } },
                               { "tetrahedra", after.tetrahedra - before.tetrahedra },
                               { "samples", after.samples - before.samples },
+                              { "bound_skipped_samples", after.boundSkippedSamples - before.boundSkippedSamples },
                               { "batches", after.batches - before.batches },
                               { "parents_uploaded", after.parentsUploaded - before.parentsUploaded },
                               { "batch_span_seconds", after.BatchSpanSeconds() - before.BatchSpanSeconds() },
@@ -138,6 +140,8 @@ TimeBackend(const std::string & name, const itk::morea::MeshModel & model, const
   const double            kernel = total.kernelSeconds - afterInit.kernelSeconds;
   const std::size_t       done = perGeneration.size();
   nlohmann::json          out{ { "backend", backend->Name() },
+                      { "refusal_bounds", gomea.boundRefusals },
+                      { "bound_skipped_samples", total.boundSkippedSamples - afterInit.boundSkippedSamples },
                       { "threads", threads ? threads : std::max(1u, std::thread::hardware_concurrency()) },
                       { "first_generation", firstGeneration },
                       { "seconds_initial_population", secondsPopulation },
@@ -174,6 +178,7 @@ AddBenchmarkCommand(CLI::App & app)
     std::size_t      threads{ 0 };
     bool             probe{ true };
     std::string      checkpoint;
+    std::string      refusalBound{ "auto" };
   };
   auto   options = std::make_shared<Options>();
   auto * cmd = app.add_subcommand("benchmark", "time MO-RV-GOMEA with the CUDA and CPU backends on a problem");
@@ -189,6 +194,10 @@ AddBenchmarkCommand(CLI::App & app)
   cmd->add_option("--from-checkpoint", options->checkpoint,
                   "start each run from this checkpoint of `morea register` (the same problem and parameters)")
     ->check(CLI::ExistingFile);
+  cmd->add_option("--refusal-bound", options->refusalBound,
+                  "skip candidates a bound shows refused: on, off, or auto (on with the cpu backend)")
+    ->check(CLI::IsMember({ "auto", "on", "off" }))
+    ->capture_default_str();
   cmd->add_option("--probe", options->probe, "measure the GPU's coherent trilinear fetch rate")->capture_default_str();
   cmd->callback([options] {
     const auto parameters = options->parameters.Load();
@@ -238,7 +247,7 @@ AddBenchmarkCommand(CLI::App & app)
         name == "cpu" ? options->cpuGenerations : (options->generations ? options->generations : gomea.generations);
       std::cout << "timing " << name << " for " << generations << " generations\n";
       report["runs"][name] = TimeBackend(name, model, evaluator, gomea, initial, generations, options->threads,
-                                          options->checkpoint);
+                                          options->checkpoint, ParseRefusalBoundChoice(options->refusalBound));
     }
     if (report.contains("runs") && report["runs"].contains("cuda") && report["runs"].contains("cpu"))
     {

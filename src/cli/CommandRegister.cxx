@@ -30,7 +30,7 @@ AddRegisterCommand(CLI::App & app)
     std::size_t      threads{ 0 };
     std::string      backend{ "auto" };
     std::size_t      killAfter{ 0 };
-    bool             sampleAll{ false };
+    std::string      refusalBound{ "auto" };
   };
   auto   options = std::make_shared<Options>();
   auto * cmd = app.add_subcommand("register", "register a problem with MOREA and write the approximation set");
@@ -50,9 +50,11 @@ AddRegisterCommand(CLI::App & app)
                   "a device is present)")
     ->check(CLI::IsMember({ "cpu", "cuda", "cuda-texture", "auto" }))
     ->capture_default_str();
-  cmd->add_flag("--sample-all", options->sampleAll,
-                "sample every candidate, also those a lower bound of their objectives shows refused (slower, same "
-                "result; for comparisons)");
+  cmd->add_option("--refusal-bound", options->refusalBound,
+                  "skip sampling candidates that a lower bound of their objectives shows refused: on, off, or auto "
+                  "(on with the cpu backend; the same result either way)")
+    ->check(CLI::IsMember({ "auto", "on", "off" }))
+    ->capture_default_str();
   // For crash-recovery tests: the process kills itself (SIGKILL) right after
   // generation N, as an external kill would, leaving only the checkpoint.
   cmd->add_option("--kill-after-generation", options->killAfter)->group("");
@@ -77,7 +79,7 @@ AddRegisterCommand(CLI::App & app)
     run.resume = options->resume;
     run.threads = options->threads;
     run.backend = ::morea::ParseBackendChoice(options->backend);
-    run.boundRefusals = !options->sampleAll;
+    run.refusalBounds = ::morea::ParseRefusalBoundChoice(options->refusalBound);
     run.onGeneration = [print = ProgressPrinter(), killAfter = options->killAfter](
                          const ::morea::GenerationRecord & r, std::size_t total) {
       print(r, total);

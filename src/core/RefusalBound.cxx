@@ -1,9 +1,23 @@
 #include "morea/RefusalBound.h"
 
+#include "morea/Error.h"
+
 #include <cmath>
 
 namespace morea
 {
+RefusalBoundChoice
+ParseRefusalBoundChoice(const std::string & name)
+{
+  if (name == "auto")
+    return RefusalBoundChoice::Auto;
+  if (name == "on")
+    return RefusalBoundChoice::On;
+  if (name == "off")
+    return RefusalBoundChoice::Off;
+  throw Error("refusal bound: '" + name + "' is none of auto, on, off");
+}
+
 Fitness
 SteeredFitness(const Fitness & raw, double guidanceLimit)
 {

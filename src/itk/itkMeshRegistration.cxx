@@ -36,7 +36,7 @@ RegisterMeshes(const RegistrationProblem & problem, const ::morea::ParameterSet 
 
   start = Clock::now();
   ::morea::GomeaOptions gomea = ::morea::GomeaOptions::FromParameters(parameters);
-  gomea.boundRefusals = options.boundRefusals;
+  gomea.boundRefusals = ::morea::UsesRefusalBounds(options.refusalBounds, *backend);
   ::morea::MoRvGomea optimiser(model.base, model.topology, model.parallel, constraint, *backend, gomea);
   if (options.resume && !options.checkpointPath.empty() && std::filesystem::exists(options.checkpointPath))
   {

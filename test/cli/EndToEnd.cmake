@@ -275,6 +275,27 @@ if(NOT gen_csv MATCHES "seconds_device_kernels,seconds_device_span,samples")
   message(FATAL_ERROR "register: generations.csv lacks the device span column")
 endif()
 
+# --- register --refusal-bound off: every candidate sampled, the same front ------------------------------
+set(reg_all "${WORK}/register-sample-all")
+morea_ok("register --refusal-bound off" register --problem "${phantom}" ${tiny} --set ea_num_generations=6
+  --refusal-bound off -o "${reg_all}")
+file(READ "${reg}/front.csv" front_bounded)
+file(READ "${reg_all}/front.csv" front_all)
+if(NOT front_bounded STREQUAL front_all)
+  message(FATAL_ERROR "register: the front with --refusal-bound off differs from the default run's")
+endif()
+file(STRINGS "${reg}/generations.csv" bounded_lines)
+list(REMOVE_AT bounded_lines 0)
+set(bounded_skipped 0)
+foreach(line IN LISTS bounded_lines)
+  string(REPLACE "," ";" fields "${line}")
+  list(GET fields 23 skipped) # bound_skipped
+  math(EXPR bounded_skipped "${bounded_skipped} + ${skipped}")
+endforeach()
+if(NOT bounded_skipped GREATER 0)
+  message(FATAL_ERROR "register: the refusal bound skipped no candidate in 6 generations")
+endif()
+
 # --- benchmark: late generations from the register run's checkpoint -----------------------------------
 set(bench_json "${WORK}/benchmark-late.json")
 morea_ok("benchmark --from-checkpoint" benchmark --problem "${phantom}" ${tiny} --set ea_num_generations=8
