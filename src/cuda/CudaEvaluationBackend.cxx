@@ -364,17 +364,17 @@ public:
         foldsRead = true;
       }
       for (std::size_t i = candidateBounds[p]; i < candidateBounds[p + 1]; ++i)
-      {
         if (Skipped(candidates[i]))
           skippedItems += first[i + 1] - first[i];
-        if (candidates[i].bound)
-          candidates[i].bound->skipped = screened && m_HostScreenSkipped[i] != 0;
-      }
-      UnpackRange(first, candidateBounds[p], candidateBounds[p + 1], [&](std::size_t i) -> TetrahedronValues * {
-        return Skipped(candidates[i]) ? nullptr : candidates[i].values; // left alone, as on the CPU
-      });
-      if (screened)
-        CountBoundSkipped(candidates, candidateBounds[p], candidateBounds[p + 1]);
+      const std::uint8_t * spared = screened ? m_HostScreenSkipped.Data() : nullptr;
+      UnpackRange(
+        first, candidateBounds[p], candidateBounds[p + 1],
+        [&](std::size_t i) -> TetrahedronValues * {
+          if (candidates[i].bound)
+            candidates[i].bound->skipped = spared && spared[i] != 0;
+          return Skipped(candidates[i]) ? nullptr : candidates[i].values; // left alone, as on the CPU
+        },
+        spared);
       m_Statistics.unpackSeconds += SecondsSince(unpack);
       if (ready)
         ready(candidateBounds[p], candidateBounds[p + 1]);
@@ -597,25 +597,6 @@ private:
                           m_Stream->Get()),
           "copying the refusal screen from the device");
     return true;
-  }
-
-  /** Moves the samples of candidates [begin, end) that the bound skipped
-   *  from the drawn samples to the spared ones. */
-  void
-  CountBoundSkipped(const std::vector<PartialCandidate> & candidates, std::size_t begin, std::size_t end)
-  {
-    for (std::size_t i = begin; i < end; ++i)
-    {
-      const PartialCandidate & c = candidates[i];
-      if (!c.bound || !c.bound->skipped)
-        continue;
-      double samples = 0.0;
-      for (std::size_t k = 0; k < c.element->dependentTetrahedra.size(); ++k)
-        samples += c.values[k].samples;
-      ++m_Statistics.boundSkipped;
-      m_Statistics.boundSkippedSamples += samples;
-      m_Statistics.samples -= samples;
-    }
   }
 
   /** Left folded by the checks and needing no values: not sampled. */
@@ -1277,10 +1258,12 @@ private:
   }
 
   /** UnpackAll for groups [begin, end) only; a group whose out(i) is null
-   *  is left alone. */
+   *  is left alone. Groups whose `spared` byte is set (null: none) were not
+   *  sampled (refusal bound): their samples count as spared. */
   template <typename Output>
   void
-  UnpackRange(const std::uint64_t * first, std::size_t begin, std::size_t end, Output out)
+  UnpackRange(const std::uint64_t * first, std::size_t begin, std::size_t end, Output out,
+              const std::uint8_t * spared = nullptr)
   {
     std::vector<double> samples(end - begin, 0.0);
     m_Pool.ParallelFor(end - begin, [&](std::size_t g) {
@@ -1295,8 +1278,14 @@ private:
         ++o;
       }
     });
-    for (double v : samples)
-      m_Statistics.samples += v;
+    for (std::size_t g = 0; g < samples.size(); ++g)
+      if (spared && spared[begin + g])
+      {
+        ++m_Statistics.boundSkipped;
+        m_Statistics.boundSkippedSamples += samples[g];
+      }
+      else
+        m_Statistics.samples += samples[g];
   }
 
   const TetrahedronEvaluator &  m_Evaluator;
