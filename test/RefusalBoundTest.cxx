@@ -159,6 +159,7 @@ TEST(RefusalBound, CpuBackendSkipsRefusedCandidatesAndSamplesThemLaterAlike)
 
   std::vector<RefusalBound> bounds(candidates.size());
   RefusalScreen             screen = Screen({ { 0.0, 0.0, 0.0 } });
+  screen.witnesses = { 77 };
   std::atomic<std::size_t>  filled{ 0 };
   screen.fill = [&](std::size_t i) {
     bounds[i].screened = i % 4 != 3; // every fourth one is not screened
@@ -187,7 +188,10 @@ TEST(RefusalBound, CpuBackendSkipsRefusedCandidatesAndSamplesThemLaterAlike)
         EXPECT_EQ(bounded[i][k].intensity, plain[i][k].intensity);
     }
     if (bounds[i].skipped)
+    {
       skipped.push_back(i);
+      EXPECT_EQ(bounds[i].witness, 77u) << "the entry that refused it";
+    }
   }
   ASSERT_FALSE(skipped.empty());
   EXPECT_GT(backend->Statistics().boundSkippedSamples, 0.0);

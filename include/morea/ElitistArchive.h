@@ -111,6 +111,10 @@ public:
   /** Objective vectors of all entries, in entry order. */
   std::vector<ObjectiveVector>
   Objectives() const;
+  /** Insertion numbers of all entries, in entry order: each names its entry
+   *  as a witness for Judge(). */
+  std::vector<std::uint64_t>
+  Witnesses() const;
 
   /** Discretisation state, so a checkpoint restores the archive exactly. */
   bool

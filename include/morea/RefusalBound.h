@@ -19,6 +19,7 @@
 #include "morea/TetrahedronObjectives.h"
 
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
@@ -49,6 +50,10 @@ struct RefusalBound
   /** Out: not sampled. Its values then hold magnitude, fold value, folds and
    *  sample counts, with intensity and guidance 0. */
   bool skipped{ false };
+  /** Out, when skipped: the archive entry that refused the bound (from
+   *  RefusalScreen::witnesses; 0: none, the bound is infeasible), the first
+   *  to try when the optimiser judges it. */
+  std::uint64_t witness{ 0 };
 };
 
 /** What bounds all candidates of a batch: the archive's objective vectors
@@ -56,6 +61,7 @@ struct RefusalBound
 struct RefusalScreen
 {
   std::vector<ObjectiveVector> archive;
+  std::vector<std::uint64_t>   witnesses; ///< per entry, its name for ElitistArchive::Judge
   std::size_t                  tetrahedra{ 0 };
   double                       guidanceLimit{ 0.0 };
   /** Fills the bound of candidate i of the EvaluatePartials call from its
@@ -84,9 +90,12 @@ Fitness
 BoundFitness(const RefusalBound & bound, const TetrahedronValues & corners, const RefusalScreen & screen);
 
 /** Whether the bound shows the candidate refused against the screen's
- *  archive: the rule both backends apply (the CUDA kernel mirrors it). */
+ *  archive: the rule both backends apply (the CUDA kernel mirrors it).
+ *  `entry` (if set) gets the refusing entry's index, or the archive's size
+ *  when the bound is refused as infeasible. */
 bool
-RefusedWhateverItsSamples(const RefusalBound & bound, const TetrahedronValues & corners, const RefusalScreen & screen);
+RefusedWhateverItsSamples(const RefusalBound & bound, const TetrahedronValues & corners, const RefusalScreen & screen,
+                          std::size_t * entry = nullptr);
 } // namespace morea
 
 #endif

@@ -170,9 +170,11 @@ public:
       }
       if (screen && c.bound && screen->fill)
         screen->fill(i);
-      if (screen && c.bound && RefusedWhateverItsSamples(*c.bound, corners.sum, *screen))
+      std::size_t entry = 0;
+      if (screen && c.bound && RefusedWhateverItsSamples(*c.bound, corners.sum, *screen, &entry))
       {
         c.bound->skipped = true;
+        c.bound->witness = entry < screen->witnesses.size() ? screen->witnesses[entry] : 0;
         return;
       }
       AddSampleSums(c);

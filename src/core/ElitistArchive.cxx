@@ -374,6 +374,16 @@ ElitistArchive::Objectives() const
   return objectives;
 }
 
+std::vector<std::uint64_t>
+ElitistArchive::Witnesses() const
+{
+  std::vector<std::uint64_t> serials;
+  serials.reserve(m_Keys.size());
+  for (const Key & k : m_Keys)
+    serials.push_back(k.serial);
+  return serials;
+}
+
 void
 ElitistArchive::Restore(std::vector<ArchiveEntry> entries, bool discretised, const ObjectiveVector & cellWidths)
 {

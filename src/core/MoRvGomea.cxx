@@ -834,6 +834,7 @@ MoRvGomea::ProcessCandidates(CandidateBatch & candidateBatch, GenerationRecord &
   {
     RefusalScreen screen;
     screen.archive = m_Archive->Objectives();
+    screen.witnesses = m_Archive->Witnesses();
     screen.tetrahedra = m_Topology.NumberOfTetrahedra();
     screen.guidanceLimit = m_SteeringLimit;
     screen.fill = [this, &candidateBatch](std::size_t i) { FillBound(candidateBatch, i); };
@@ -939,7 +940,9 @@ MoRvGomea::AcceptCandidates(CandidateBatch & candidateBatch, const std::vector<P
         accept = Accepted(c, next, chain.now, nullptr);
       else
       {
-        j.verdicts[b] = m_Archive->Judge(next, chain.witness);
+        // A skipped candidate's bound was refused by the entry it names.
+        const RefusalBound * bound = batch[batchIndex[b]].bound;
+        j.verdicts[b] = m_Archive->Judge(next, bound && bound->skipped && bound->witness ? bound->witness : chain.witness);
         chain.witness = j.verdicts[b].witness;
         accept = ConstraintDominates(next, chain.now) || j.verdicts[b].kind == ArchiveVerdict::Kind::Accepted;
       }

@@ -42,23 +42,32 @@ BoundFitness(const RefusalBound & bound, const TetrahedronValues & corners, cons
 }
 
 bool
-RefusedWhateverItsSamples(const RefusalBound & bound, const TetrahedronValues & corners, const RefusalScreen & screen)
+RefusedWhateverItsSamples(const RefusalBound & bound, const TetrahedronValues & corners, const RefusalScreen & screen,
+                          std::size_t * entry)
 {
   if (!bound.screened)
     return false;
   const Fitness low = BoundFitness(bound, corners, screen);
   if (ConstraintDominates(low, bound.parent))
     return false;
-  if (!low.feasible)
-    return true;
-  for (const ObjectiveVector & entry : screen.archive)
+  std::size_t e = 0;
+  if (low.feasible)
   {
-    bool worse = false;
-    for (std::size_t j = 0; j < entry.size(); ++j)
-      worse |= entry[j] > low.objectives[j];
-    if (!worse)
-      return true;
+    for (; e < screen.archive.size(); ++e)
+    {
+      bool worse = false;
+      for (std::size_t j = 0; j < NumberOfObjectives; ++j)
+        worse |= screen.archive[e][j] > low.objectives[j];
+      if (!worse)
+        break;
+    }
+    if (e == screen.archive.size())
+      return false;
   }
-  return false;
+  else
+    e = screen.archive.size();
+  if (entry)
+    *entry = e;
+  return true;
 }
 } // namespace morea

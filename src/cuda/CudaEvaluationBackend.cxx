@@ -366,12 +366,17 @@ public:
       for (std::size_t i = candidateBounds[p]; i < candidateBounds[p + 1]; ++i)
         if (Skipped(candidates[i]))
           skippedItems += first[i + 1] - first[i];
-      const std::uint8_t * spared = screened ? m_HostScreenSkipped.Data() : nullptr;
+      const std::uint32_t * spared = screened ? m_HostScreenRefusal.Data() : nullptr;
+      const auto &          witnesses = m_RefusalScreen.witnesses;
       UnpackRange(
         first, candidateBounds[p], candidateBounds[p + 1],
         [&](std::size_t i) -> TetrahedronValues * {
-          if (candidates[i].bound)
-            candidates[i].bound->skipped = spared && spared[i] != 0;
+          if (RefusalBound * bound = candidates[i].bound)
+          {
+            const std::uint32_t by = spared ? spared[i] : 0;
+            bound->skipped = by != 0;
+            bound->witness = by != 0 && by - 1 < witnesses.size() ? witnesses[by - 1] : 0;
+          }
           return Skipped(candidates[i]) ? nullptr : candidates[i].values; // left alone, as on the CPU
         },
         spared);
@@ -546,7 +551,7 @@ public:
 private:
   /** Queues the refusal screen of a batch whose corners are queued, when
    *  the optimiser set one and bounds some candidate; its outcome reaches
-   *  m_HostScreenSkipped before the first part's values. */
+   *  m_HostScreenRefusal before the first part's values. */
   bool
   ScreenCandidates(const std::vector<PartialCandidate> & candidates)
   {
@@ -589,12 +594,12 @@ private:
     view.tetrahedra = static_cast<double>(m_RefusalScreen.tetrahedra);
     view.guidanceLimit = m_RefusalScreen.guidanceLimit;
     view.foldOffset = FoldConstraintOffset;
-    m_ScreenSkipped.Reserve(n);
-    m_HostScreenSkipped.Reserve(n);
+    m_ScreenRefusal.Reserve(n);
+    m_HostScreenRefusal.Reserve(n);
     cuda::LaunchScreenCandidates(m_Constants, m_Batch, m_Corners.Data(), m_Tetrahedra.Data(), view, m_ItemSkip.Data(),
-                                 m_ScreenSkipped.Data(), m_Stream->Get());
-    Check(cudaMemcpyAsync(m_HostScreenSkipped.Data(), m_ScreenSkipped.Data(), n, cudaMemcpyDeviceToHost,
-                          m_Stream->Get()),
+                                 m_ScreenRefusal.Data(), m_Stream->Get());
+    Check(cudaMemcpyAsync(m_HostScreenRefusal.Data(), m_ScreenRefusal.Data(), n * sizeof(std::uint32_t),
+                          cudaMemcpyDeviceToHost, m_Stream->Get()),
           "copying the refusal screen from the device");
     return true;
   }
@@ -1263,7 +1268,7 @@ private:
   template <typename Output>
   void
   UnpackRange(const std::uint64_t * first, std::size_t begin, std::size_t end, Output out,
-              const std::uint8_t * spared = nullptr)
+              const std::uint32_t * spared = nullptr)
   {
     std::vector<double> samples(end - begin, 0.0);
     m_Pool.ParallelFor(end - begin, [&](std::size_t g) {
@@ -1353,8 +1358,8 @@ private:
   cuda::DeviceArray<cuda::CandidateBoundInput> m_Bounds;
   cuda::PinnedArray<double>                    m_HostArchive;
   cuda::DeviceArray<double>                    m_Archive;
-  cuda::DeviceArray<std::uint8_t>              m_ScreenSkipped;
-  cuda::PinnedArray<std::uint8_t>              m_HostScreenSkipped;
+  cuda::DeviceArray<std::uint32_t>             m_ScreenRefusal; ///< see LaunchScreenCandidates
+  cuda::PinnedArray<std::uint32_t>             m_HostScreenRefusal;
   std::unique_ptr<cuda::Stream>                m_FallbackStream;
   cuda::PinnedArray<std::uint64_t>             m_HostFallbackItems;
   cuda::DeviceArray<std::uint64_t>             m_FallbackItems;

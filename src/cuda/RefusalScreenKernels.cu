@@ -82,7 +82,7 @@ RefusedBeforeArchive(const CandidateBoundInput & b, const RefusalScreenView & sc
 __global__ void
 ScreenCandidates(EvaluationConstants k, CandidateBatch batch, const double * __restrict__ corners,
                  const std::uint32_t * __restrict__ tetrahedra, RefusalScreenView screen, std::uint8_t * itemSkip,
-                 std::uint8_t * skipped)
+                 std::uint32_t * refusal)
 {
   const std::size_t c = (static_cast<std::size_t>(blockIdx.x) * blockDim.x + threadIdx.x) / 32;
   if (c >= batch.candidates)
@@ -107,7 +107,8 @@ ScreenCandidates(EvaluationConstants k, CandidateBatch batch, const double * __r
       sums[3] += folded;
     }
   const bool screened = b.screened != 0 && end > first && __all_sync(0xffffffffu, sampled);
-  bool       refused = false;
+  bool          refused = false;
+  std::uint32_t by = screen.archiveSize; // the refusing entry; archiveSize: infeasible
   if (screened)
   {
     for (double & s : sums)
@@ -124,14 +125,19 @@ ScreenCandidates(EvaluationConstants k, CandidateBatch batch, const double * __r
           const double * y = screen.archive + 3 * static_cast<std::size_t>(e);
           found = y[0] <= low[0] && y[1] <= low[1] && y[2] <= low[2];
         }
-        refused = __any_sync(0xffffffffu, found);
+        const unsigned finders = __ballot_sync(0xffffffffu, found);
+        if (finders != 0)
+        {
+          refused = true;
+          by = e - lane + static_cast<std::uint32_t>(__ffs(static_cast<int>(finders)) - 1);
+        }
       }
   }
   if (refused)
     for (std::size_t item = first + lane; item < end; item += 32)
       itemSkip[item] = ItemBoundSkipped;
   if (lane == 0)
-    skipped[c] = refused ? 1 : 0;
+    refusal[c] = refused ? 1 + by : 0;
 }
 
 __global__ void
@@ -153,7 +159,7 @@ GatherItems(const double * __restrict__ corners, const std::uint32_t * __restric
 void
 LaunchScreenCandidates(const EvaluationConstants & constants, const CandidateBatch & batch, const double * corners,
                        const std::uint32_t * tetrahedra, const RefusalScreenView & screen, std::uint8_t * itemSkip,
-                       std::uint8_t * skipped, void * stream)
+                       std::uint32_t * refusal, void * stream)
 {
   if (batch.candidates == 0)
     return;
@@ -161,7 +167,7 @@ LaunchScreenCandidates(const EvaluationConstants & constants, const CandidateBat
   const unsigned    blocks = static_cast<unsigned>((threads + ScreenThreads - 1) / ScreenThreads);
   ScreenCandidates<<<blocks, ScreenThreads, 0, static_cast<cudaStream_t>(stream)>>>(constants, batch, corners,
                                                                                     tetrahedra, screen, itemSkip,
-                                                                                    skipped);
+                                                                                    refusal);
   Check(cudaGetLastError(), "launching the refusal screen");
 }
 

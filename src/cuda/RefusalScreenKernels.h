@@ -39,12 +39,13 @@ struct RefusalScreenView
 /** For every candidate of `batch` whose items `corners` and `tetrahedra` hold
  *  (LaunchGatherCandidateCorners) and are all ItemSampled: bounds it from
  *  its items' magnitude, folds and sample counts; where the bound is
- *  refused, sets its items' `itemSkip` to ItemBoundSkipped and skipped[c]
- *  to 1 (else 0). Asynchronous on `stream`. */
+ *  refused, sets its items' `itemSkip` to ItemBoundSkipped and refusal[c]
+ *  to 1 + the index of the archive entry that refused it (1 + archiveSize:
+ *  refused as infeasible), else to 0. Asynchronous on `stream`. */
 void
 LaunchScreenCandidates(const EvaluationConstants & constants, const CandidateBatch & batch, const double * corners,
                        const std::uint32_t * tetrahedra, const RefusalScreenView & screen, std::uint8_t * itemSkip,
-                       std::uint8_t * skipped, void * stream);
+                       std::uint32_t * refusal, void * stream);
 
 /** Copies items `items[i]` (count of them) of `corners` and `tetrahedra` to
  *  position i of `outCorners` and `outTetrahedra`. Asynchronous on `stream`. */
