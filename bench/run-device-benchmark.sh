@@ -16,6 +16,8 @@
 #                  does both on the GPU machine.
 #   Kernels of several builds: bench/run-device-benchmark.sh early OUTDIR GENERATIONS ROUNDS
 #                  BACKEND PROGRAM... times early generations from scratch, programs in turns.
+#   Refusal bound: bench/run-device-benchmark.sh bound OUTDIR SECONDS BACKEND GENERATIONS [ROUNDS]
+#                  times late generations with --refusal-bound on and off in turns.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 DATA=${MOREA_DATA:-../shared/data/abdomen-cbct-pair}
@@ -154,10 +156,41 @@ EOF
       done
     done
     ;;
+  bound)
+    # The refusal bound on and off over the same late generations: the
+    # bundle's morea registers for SECONDS, then `morea benchmark` times
+    # GENERATIONS from that checkpoint on BACKEND with --refusal-bound on and
+    # off in turns, ROUNDS times (OUTDIR/BACKEND-on|off-ROUND.json).
+    out=${2:?output folder}
+    seconds=${3:?seconds of the start}
+    backend=${4:?backend}
+    generations=${5:?generations}
+    rounds=${6:-1}
+    mkdir -p "$out" /tmp/b /tmp/ab
+    [ -x /tmp/b/bin/morea ] || tar xJf device-carry/bundle.tar.xz -C /tmp/b
+    export LD_LIBRARY_PATH=/tmp/b/lib
+    rm -rf /tmp/ab/bound
+    register /tmp/b/bin/morea /tmp/ab/bound "$seconds" cuda-texture || true
+    for round in $(seq "$rounds"); do
+      for bound in on off; do
+        name="$backend-$bound-$round"
+        /tmp/b/bin/morea benchmark "${PROBLEM[@]}" --backends "$backend" --generations "$generations" \
+          --cpu-generations "$generations" --threads 16 --probe 0 --refusal-bound "$bound" \
+          --from-checkpoint /tmp/ab/bound/checkpoint.bin -o "$out/$name.json" > "$out/$name.log" 2>&1
+        python3 - "$out/$name.json" "$backend" "$name" <<'EOF'
+import json, sys
+run = json.load(open(sys.argv[1]))["runs"][sys.argv[2]]
+print(f"{sys.argv[3]}: from generation {run['first_generation']}, {run['seconds_per_generation']:.4f} s per "
+      f"generation, {run['seconds_in_kernels'] / run['generations']:.4f} s in kernels, samples {run['samples']:.4g}, "
+      f"spared {run['bound_skipped_samples']:.4g}")
+EOF
+      done
+    done
+    ;;
   *)
     echo "usage: $0 bundle | run OUTDIR [morea benchmark options] | register OUTDIR RUNDIR [SECONDS [BACKEND]]" \
       "| ab OUTDIR SECONDS BACKEND PROGRAM... | late OUTDIR SECONDS BACKEND [GENERATIONS]" \
-      "| early OUTDIR GENERATIONS ROUNDS BACKEND PROGRAM..." >&2
+      "| early OUTDIR GENERATIONS ROUNDS BACKEND PROGRAM... | bound OUTDIR SECONDS BACKEND GENERATIONS [ROUNDS]" >&2
     exit 2
     ;;
 esac
