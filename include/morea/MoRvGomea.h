@@ -57,7 +57,8 @@ struct GomeaOptions
    *  hardware thread). The result does not depend on it. */
   std::size_t threads{ 0 };
   /** Lets the backend skip sampling candidates that a bound shows refused
-   *  (RefusalBound.h). The result does not depend on it. */
+   *  (RefusalBound.h). The result does not depend on it; whether it saves
+   *  time depends on the backend (UsesRefusalBounds decides for `morea`). */
   bool boundRefusals{ true };
 
   /** ea_* keys, morea_repair_method and seed. */

@@ -450,8 +450,12 @@ public:
         throw Error("evaluation backend: only candidates the bound skipped can be sampled later");
       count += h.firstItem[i + 1] - h.firstItem[i];
     }
-    if (count == 0)
+    if (count == 0) // no tetrahedra: nothing to sample
+    {
+      for (std::size_t i : which)
+        candidates[i].bound->skipped = false;
       return;
+    }
     // The items' corners are still on the device, from the batch's gather.
     // They are sampled on a stream of their own, whose blocks go before the
     // later parts' sampling; the same arithmetic gives the same sums.
