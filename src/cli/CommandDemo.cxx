@@ -62,6 +62,7 @@ AddDemoCommand(CLI::App & app)
     std::string      output{ "demo-out" };
     double           spacing{ 2.0 };
     ParameterOptions parameters;
+    std::string      refusalBound{ "auto" };
   };
   auto   options = std::make_shared<Options>();
   auto * cmd = app.add_subcommand("demo", "run the default job on the embedded phantom and print its scores");
@@ -69,6 +70,10 @@ AddDemoCommand(CLI::App & app)
   cmd->add_option("--phantom-spacing", options->spacing, "voxel size of the generated phantom in mm")
     ->capture_default_str();
   options->parameters.AddTo(*cmd);
+  cmd->add_option("--refusal-bound", options->refusalBound,
+                  "skip candidates a bound shows refused: on, off, or auto (on with the cpu backend; the same result)")
+    ->check(CLI::IsMember({ "auto", "on", "off" }))
+    ->capture_default_str();
   cmd->callback([options] {
     using namespace itk::morea;
     namespace fs = std::filesystem;
@@ -118,6 +123,7 @@ AddDemoCommand(CLI::App & app)
               << " mesh points)\n";
     itk::morea::MeshRegistrationOptions run;
     run.onGeneration = ProgressPrinter();
+    run.refusalBounds = ::morea::ParseRefusalBoundChoice(options->refusalBound);
     const auto registration = RegisterMeshes(result.problem, parameters, run);
     const auto chosen = ChooseSolutions(registration.front, "best-guidance,knee");
     const auto summary =
