@@ -40,6 +40,23 @@ register() {
   timeout --signal=KILL "$3" "$1" register "${PROBLEM[@]}" --backend "$4" \
     --checkpoint-every 10 --resume -o "$2" >> "$2/register.log" 2>&1
 }
+# The bundle unpacked into /tmp/b (once per machine) and its libraries found.
+unpack_bundle() {
+  mkdir -p /tmp/b
+  [ -x /tmp/b/bin/morea ] || tar xJf device-carry/bundle.tar.xz -C /tmp/b
+  export LD_LIBRARY_PATH=/tmp/b/lib
+}
+
+# summary JSON BACKEND NAME: one line of a `morea benchmark` run.
+summary() {
+  python3 - "$1" "$2" "$3" <<'EOF'
+import json, sys
+run = json.load(open(sys.argv[1]))["runs"][sys.argv[2]]
+print(f"{sys.argv[3]}: from generation {run['first_generation']}, {run['samples_per_second_kernel']:.4e} samples/s "
+      f"in kernels, {run['seconds_per_generation']:.4f} s per generation, {run['seconds_in_kernels']:.3f} s in "
+      f"kernels, samples {run['samples']:.4g}, spared {run.get('bound_skipped_samples', 0):.4g}")
+EOF
+}
 case "${1:-}" in
   bundle)
     cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
@@ -71,9 +88,8 @@ case "${1:-}" in
     run=${3:?run folder}
     seconds=${4:-540}
     backend=${5:-cuda}
-    mkdir -p "$out" "$run" /tmp/b
-    [ -x /tmp/b/bin/morea ] || tar xJf device-carry/bundle.tar.xz -C /tmp/b
-    export LD_LIBRARY_PATH=/tmp/b/lib
+    mkdir -p "$out" "$run"
+    unpack_bundle
     status=0
     register /tmp/b/bin/morea "$run" "$seconds" "$backend" || status=$?
     tail -c 4000 "$run/register.log" | tee "$out/register-tail.log"
@@ -90,9 +106,8 @@ case "${1:-}" in
     seconds=${3:?seconds of the common start}
     backend=${4:?backend}
     shift 4
-    mkdir -p "$out" /tmp/b /tmp/ab
-    [ -x /tmp/b/bin/morea ] || tar xJf device-carry/bundle.tar.xz -C /tmp/b
-    export LD_LIBRARY_PATH=/tmp/b/lib
+    mkdir -p "$out" /tmp/ab
+    unpack_bundle
     # The common start lives outside /tmp/ab, where each program has a
     # folder of its name.
     start=/tmp/ab-common-start
@@ -119,9 +134,8 @@ case "${1:-}" in
     seconds=${3:?seconds of the start}
     backend=${4:?backend}
     generations=${5:-40}
-    mkdir -p "$out" /tmp/b /tmp/ab
-    [ -x /tmp/b/bin/morea ] || tar xJf device-carry/bundle.tar.xz -C /tmp/b
-    export LD_LIBRARY_PATH=/tmp/b/lib
+    mkdir -p "$out" /tmp/ab
+    unpack_bundle
     rm -rf /tmp/ab/late
     register /tmp/b/bin/morea /tmp/ab/late "$seconds" "$backend" || true
     /tmp/b/bin/morea benchmark "${PROBLEM[@]}" --backends "$backend" \
@@ -139,20 +153,14 @@ case "${1:-}" in
     rounds=${4:?rounds}
     backend=${5:?backend}
     shift 5
-    mkdir -p "$out" /tmp/b
-    [ -x /tmp/b/bin/morea ] || tar xJf device-carry/bundle.tar.xz -C /tmp/b
-    export LD_LIBRARY_PATH=/tmp/b/lib
+    mkdir -p "$out"
+    unpack_bundle
     for round in $(seq "$rounds"); do
       for program in "$@"; do
         name=$(basename "$program")
         "$program" benchmark "${PROBLEM[@]}" --backends "$backend" --generations "$generations" --probe 0 \
           -o "$out/$name-$round.json" > "$out/$name-$round.log" 2>&1 || { tail -3 "$out/$name-$round.log"; continue; }
-        python3 - "$out/$name-$round.json" "$backend" "$name" <<'EOF'
-import json, sys
-run = json.load(open(sys.argv[1]))["runs"][sys.argv[2]]
-print(f"{sys.argv[3]}: {run['samples_per_second_kernel']:.4e} samples/s in kernels, "
-      f"{run['seconds_per_generation']:.4f} s per generation, {run['seconds_in_kernels']:.3f} s in kernels")
-EOF
+        summary "$out/$name-$round.json" "$backend" "$name"
       done
     done
     ;;
@@ -166,9 +174,8 @@ EOF
     backend=${4:?backend}
     generations=${5:?generations}
     rounds=${6:-1}
-    mkdir -p "$out" /tmp/b /tmp/ab
-    [ -x /tmp/b/bin/morea ] || tar xJf device-carry/bundle.tar.xz -C /tmp/b
-    export LD_LIBRARY_PATH=/tmp/b/lib
+    mkdir -p "$out" /tmp/ab
+    unpack_bundle
     rm -rf /tmp/ab/bound
     register /tmp/b/bin/morea /tmp/ab/bound "$seconds" cuda-texture || true
     for round in $(seq "$rounds"); do
@@ -177,13 +184,7 @@ EOF
         /tmp/b/bin/morea benchmark "${PROBLEM[@]}" --backends "$backend" --generations "$generations" \
           --cpu-generations "$generations" --threads 16 --probe 0 --refusal-bound "$bound" \
           --from-checkpoint /tmp/ab/bound/checkpoint.bin -o "$out/$name.json" > "$out/$name.log" 2>&1
-        python3 - "$out/$name.json" "$backend" "$name" <<'EOF'
-import json, sys
-run = json.load(open(sys.argv[1]))["runs"][sys.argv[2]]
-print(f"{sys.argv[3]}: from generation {run['first_generation']}, {run['seconds_per_generation']:.4f} s per "
-      f"generation, {run['seconds_in_kernels'] / run['generations']:.4f} s in kernels, samples {run['samples']:.4g}, "
-      f"spared {run['bound_skipped_samples']:.4g}")
-EOF
+        summary "$out/$name.json" "$backend" "$name"
       done
     done
     ;;

@@ -116,46 +116,14 @@ TEST(RefusalBound, CpuBackendSkipsRefusedCandidatesAndSamplesThemLaterAlike)
   OptimiserTestProblem problem;
   GomeaOptions         options = problem.Options(5);
   options.populationSize = 3;
-  const auto                     population = problem.InitialPopulation(options);
-  const auto &                   group = problem.parallel.groups.front();
-  std::vector<PartialCandidate>  candidates;
-  std::vector<std::vector<Vec3>> points;
-  points.reserve(2 * group.size() * population.size());
-  for (const DualMesh & parent : population)
-    for (std::uint32_t e : group)
-    {
-      const FosElement & element = problem.parallel.elements[e];
-      std::vector<Vec3>  source, target;
-      for (std::uint32_t p : element.points)
-      {
-        source.push_back(parent.source[p]);
-        target.push_back(parent.target[p]);
-        source.back()[0] += 0.3;
-      }
-      points.push_back(std::move(source));
-      points.push_back(std::move(target));
-      PartialCandidate c;
-      c.parent = &parent;
-      c.element = &element;
-      c.source = points[points.size() - 2].data();
-      c.target = points.back().data();
-      candidates.push_back(c);
-    }
-  const auto withValues = [&](std::vector<std::vector<TetrahedronValues>> & values,
-                              std::vector<RefusalBound> * bounds) {
-    std::vector<PartialCandidate> batch = candidates;
-    values.assign(batch.size(), {});
-    for (std::size_t i = 0; i < batch.size(); ++i)
-    {
-      values[i].resize(batch[i].element->dependentTetrahedra.size());
-      batch[i].values = values[i].data();
-      batch[i].bound = bounds ? &(*bounds)[i] : nullptr;
-    }
-    return batch;
-  };
-  auto                                        backend = CreateCpuEvaluationBackend(*problem.evaluator, 2);
-  std::vector<std::vector<TetrahedronValues>> plain, bounded;
-  backend->EvaluatePartials(withValues(plain, nullptr));
+  const auto   population = problem.InitialPopulation(options);
+  const auto & group = problem.parallel.groups.front();
+  // The same points twice (one seed): evaluated plainly and with bounds.
+  morea_test::RandomCandidates plain(problem, population, group, 0.1, 7);
+  morea_test::RandomCandidates bounded(problem, population, group, 0.1, 7);
+  const std::vector<PartialCandidate> & candidates = plain.candidates;
+  auto                                  backend = CreateCpuEvaluationBackend(*problem.evaluator, 2);
+  backend->EvaluatePartials(plain.candidates);
 
   std::vector<RefusalBound> bounds(candidates.size());
   RefusalScreen             screen = Screen({ { 0.0, 0.0, 0.0 } });
@@ -169,7 +137,9 @@ TEST(RefusalBound, CpuBackendSkipsRefusedCandidatesAndSamplesThemLaterAlike)
     ++filled;
   };
   backend->SetRefusalScreen(screen);
-  const std::vector<PartialCandidate> batch = withValues(bounded, &bounds);
+  std::vector<PartialCandidate> & batch = bounded.candidates;
+  for (std::size_t i = 0; i < batch.size(); ++i)
+    batch[i].bound = &bounds[i];
   backend->EvaluatePartials(batch);
   backend->ClearRefusalScreen();
   EXPECT_EQ(filled.load(), candidates.size());
@@ -177,15 +147,17 @@ TEST(RefusalBound, CpuBackendSkipsRefusedCandidatesAndSamplesThemLaterAlike)
   for (std::size_t i = 0; i < candidates.size(); ++i)
   {
     EXPECT_EQ(bounds[i].skipped, i % 4 != 3) << i;
-    for (std::size_t k = 0; k < plain[i].size(); ++k)
+    const auto & p = plain.values[i];
+    const auto & v = bounded.values[i];
+    for (std::size_t k = 0; k < p.size(); ++k)
     {
-      EXPECT_EQ(bounded[i][k].magnitude, plain[i][k].magnitude);
-      EXPECT_EQ(bounded[i][k].samples, plain[i][k].samples);
-      EXPECT_EQ(bounded[i][k].folded, plain[i][k].folded);
+      EXPECT_EQ(v[k].magnitude, p[k].magnitude);
+      EXPECT_EQ(v[k].samples, p[k].samples);
+      EXPECT_EQ(v[k].folded, p[k].folded);
       if (bounds[i].skipped)
-        EXPECT_EQ(bounded[i][k].intensity, 0.0);
+        EXPECT_EQ(v[k].intensity, 0.0);
       else
-        EXPECT_EQ(bounded[i][k].intensity, plain[i][k].intensity);
+        EXPECT_EQ(v[k].intensity, p[k].intensity);
     }
     if (bounds[i].skipped)
     {
@@ -201,10 +173,10 @@ TEST(RefusalBound, CpuBackendSkipsRefusedCandidatesAndSamplesThemLaterAlike)
   for (std::size_t i : skipped)
   {
     EXPECT_FALSE(bounds[i].skipped);
-    for (std::size_t k = 0; k < plain[i].size(); ++k)
+    for (std::size_t k = 0; k < plain.values[i].size(); ++k)
     {
-      EXPECT_EQ(bounded[i][k].intensity, plain[i][k].intensity);
-      EXPECT_EQ(bounded[i][k].guidance, plain[i][k].guidance);
+      EXPECT_EQ(bounded.values[i][k].intensity, plain.values[i][k].intensity);
+      EXPECT_EQ(bounded.values[i][k].guidance, plain.values[i][k].guidance);
     }
   }
   // Only skipped candidates can be sampled later.

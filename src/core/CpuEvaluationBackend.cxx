@@ -8,6 +8,7 @@
 #include "morea/ThreadPool.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 
 namespace morea
@@ -159,25 +160,28 @@ public:
         c.bound->skipped = false;
       if (skip[i])
         return;
-      Corners           source, target;
-      const auto &      dependent = c.element->dependentTetrahedra;
-      ObjectiveTotals   corners;
+      // Each tetrahedron's corners once, for its corner values and its samples.
+      thread_local std::vector<std::array<Corners, 2>> corners;
+      const auto &                                     dependent = c.element->dependentTetrahedra;
+      corners.resize(dependent.size());
+      ObjectiveTotals sums;
       for (std::size_t k = 0; k < dependent.size(); ++k)
       {
-        CandidateCorners(c, tets[dependent[k]], source, target);
-        c.values[k] = m_Evaluator.EvaluateCorners(dependent[k], source, target);
-        corners.Add(c.values[k]);
+        CandidateCorners(c, tets[dependent[k]], corners[k][0], corners[k][1]);
+        c.values[k] = m_Evaluator.EvaluateCorners(dependent[k], corners[k][0], corners[k][1]);
+        sums.Add(c.values[k]);
       }
       if (screen && c.bound && screen->fill)
         screen->fill(i);
       std::size_t entry = 0;
-      if (screen && c.bound && RefusedWhateverItsSamples(*c.bound, corners.sum, *screen, &entry))
+      if (screen && c.bound && RefusedWhateverItsSamples(*c.bound, sums.sum, *screen, &entry))
       {
         c.bound->skipped = true;
         c.bound->witness = entry < screen->witnesses.size() ? screen->witnesses[entry] : 0;
         return;
       }
-      AddSampleSums(c);
+      for (std::size_t k = 0; k < dependent.size(); ++k)
+        m_Evaluator.AddSampleSums(corners[k][0], corners[k][1], c.values[k]);
     });
     ++m_Statistics.batches;
     for (std::size_t i = 0; i < candidates.size(); ++i)

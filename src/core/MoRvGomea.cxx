@@ -918,10 +918,8 @@ MoRvGomea::AcceptCandidates(CandidateBatch & candidateBatch, const std::vector<P
   // bound is not refused on the chain's totals so far (an earlier candidate
   // of the chain was accepted), the chain stops there; the backend samples
   // all stopped candidates at once and their chains go on.
-  const auto skipped = [&](std::size_t b) {
-    const RefusalBound * bound = batch[batchIndex[b]].bound;
-    return bound != nullptr && bound->skipped;
-  };
+  const auto boundOf = [&](std::size_t b) { return batch[batchIndex[b]].bound; };
+  const auto skipped = [&](std::size_t b) { return boundOf(b) != nullptr && boundOf(b)->skipped; };
   const auto runChain = [&](std::size_t s) {
     CandidateBatch::Judged::Chain & chain = j.chains[s];
     for (; chain.at < j.chainStart[s + 1]; ++chain.at)
@@ -941,8 +939,8 @@ MoRvGomea::AcceptCandidates(CandidateBatch & candidateBatch, const std::vector<P
       else
       {
         // A skipped candidate's bound was refused by the entry it names.
-        const RefusalBound * bound = batch[batchIndex[b]].bound;
-        j.verdicts[b] = m_Archive->Judge(next, bound && bound->skipped && bound->witness ? bound->witness : chain.witness);
+        const std::uint64_t hint = skipped(b) && boundOf(b)->witness ? boundOf(b)->witness : chain.witness;
+        j.verdicts[b] = m_Archive->Judge(next, hint);
         chain.witness = j.verdicts[b].witness;
         accept = ConstraintDominates(next, chain.now) || j.verdicts[b].kind == ArchiveVerdict::Kind::Accepted;
       }

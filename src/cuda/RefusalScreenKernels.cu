@@ -25,14 +25,6 @@ WarpTotal(double x)
   return x;
 }
 
-/** Samples one direction of a tetrahedron gets (TetrahedronEvaluator::SampleCount). */
-__device__ double
-SampleCount(const EvaluationConstants & k, const double c[12])
-{
-  const double count = round(__ddiv_rn(__dmul_rn(k.samplingRate, fabs(SignedVolume(c))), k.voxelVolume));
-  return count < 1.0 ? 1.0 : count;
-}
-
 /** The bound's fitness, steered (morea::BoundFitness), and whether the
  *  candidate is refused whatever its samples (morea::RefusedWhateverItsSamples)
  *  but for the archive, which the caller scans when `scan` comes back true. */
@@ -101,7 +93,7 @@ ScreenCandidates(EvaluationConstants k, CandidateBatch batch, const double * __r
       const std::uint32_t t = tetrahedra[item];
       double              folded = 0.0;
       sums[0] += TetrahedronMagnitude(source, target, k.elasticity ? k.elasticity[t] : 1.0);
-      sums[1] += SampleCount(k, source) + SampleCount(k, target);
+      sums[1] += SampleCount(k.samplingRate, k.voxelVolume, source) + SampleCount(k.samplingRate, k.voxelVolume, target);
       sums[2] += VolumeViolation(SignedVolume(source), k.referenceVolumes[t], k.volumeFraction, folded);
       sums[2] += VolumeViolation(SignedVolume(target), k.referenceVolumes[t], k.volumeFraction, folded);
       sums[3] += folded;

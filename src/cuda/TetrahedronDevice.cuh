@@ -113,6 +113,15 @@ SignedVolume(const double c[12])
   return __ddiv_rn(SixfoldSignedVolume(c), 6.0);
 }
 
+/** Samples one direction of a tetrahedron with corners `c` gets: rate x
+ *  |volume| / voxel volume, rounded, at least 1 (TetrahedronEvaluator::SampleCount). */
+inline __device__ double
+SampleCount(double samplingRate, double voxelVolume, const double c[12])
+{
+  const double count = round(__ddiv_rn(__dmul_rn(samplingRate, fabs(SignedVolume(c))), voxelVolume));
+  return count < 1.0 ? 1.0 : count;
+}
+
 inline __device__ double
 VolumeViolation(double v, double reference, double fraction, double & folded)
 {

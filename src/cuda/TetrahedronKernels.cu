@@ -169,12 +169,10 @@ EvaluateTetrahedraKernel(EvaluationConstants k, View moving, View fixed, const d
   const View fromImage = direction == 0 ? moving : fixed;
   const View toImage = direction == 0 ? fixed : moving;
 
-  const double volume = fabs(SignedVolume(from));
-  double       count = round(__ddiv_rn(__dmul_rn(k.samplingRate, volume), k.voxelVolume));
   // Not sampled: an item whose values go unused gets no sample count either,
   // one a refusal bound skipped keeps its count (ItemSkip).
   const std::uint8_t  skip = itemSkip != nullptr ? itemSkip[item] : ItemSampled;
-  const std::uint32_t full = count < 1.0 ? 1u : static_cast<std::uint32_t>(count);
+  const auto          full = static_cast<std::uint32_t>(SampleCount(k.samplingRate, k.voxelVolume, from));
   const std::uint32_t n = skip == ItemSampled ? full : 0u;
   std::uint32_t       shift[4];
   SobolShifts(TetrahedronSeed(from), shift);

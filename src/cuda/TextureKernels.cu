@@ -183,9 +183,7 @@ __device__ void
 PrepareDirection(const EvaluationConstants & k, const double from[12], const double to[12],
                  const PackedVolumeView & fromImage, const PackedVolumeView & toImage, SampleTask & task)
 {
-  const double volume = fabs(SignedVolume(from));
-  const double count = round(__ddiv_rn(__dmul_rn(k.samplingRate, volume), k.voxelVolume));
-  task.samples = count < 1.0 ? 1u : static_cast<std::uint32_t>(count);
+  task.samples = static_cast<std::uint32_t>(SampleCount(k.samplingRate, k.voxelVolume, from));
   SobolShifts(TetrahedronSeed(from), task.shift);
   TexelCorners(fromImage, from, task.from);
   TexelCorners(toImage, to, task.to);
