@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <limits>
 #include <numeric>
 #include <vector>
 
@@ -657,6 +658,23 @@ TEST(CudaEvaluationBackend, CandidatesStartedEarlyGetTheValuesOfAWholeBatch)
   auto late = CreateCudaEvaluationBackend(*problem.evaluator, 2, CudaInterpolation::Texture);
   early->SetFoldHandling(handling);
   late->SetFoldHandling(handling);
+  // `next` is screened by the screen it is started with, head and rest: an
+  // archive entry at 0 refuses every screened bound (every fourth candidate
+  // is not screened); the skipped ones are sampled later.
+  std::vector<RefusalBound> bounds(next.candidates.size());
+  for (std::size_t i = 0; i < bounds.size(); ++i)
+    next.candidates[i].bound = &bounds[i];
+  RefusalScreen screen;
+  screen.archive = { { 0.0, 0.0, 0.0 } };
+  screen.witnesses = { 77 };
+  screen.tetrahedra = problem.topology.NumberOfTetrahedra();
+  screen.guidanceLimit = std::numeric_limits<double>::infinity();
+  screen.fill = [&](std::size_t i) {
+    bounds[i].screened = i % 4 != 3;
+    bounds[i].parent.objectives = { { 0.0, 0.0, 0.0 } };
+    bounds[i].parent.feasible = true;
+    bounds[i].rest.samples = 1.0;
+  };
   // While `first` is handed over, the candidates of `next` whose parents it
   // has finished with start early.
   std::size_t ranges = 0;
@@ -670,13 +688,32 @@ TEST(CudaEvaluationBackend, CandidatesStartedEarlyGetTheValuesOfAWholeBatch)
       std::size_t       head = 0;
       while (head < next.candidates.size() && parentIndex(next.candidates[head]) < pending)
         ++head;
-      early->StartNextPartials(next.candidates, head);
+      early->StartNextPartials(next.candidates, head, &screen);
     },
     [&] { early->PrepareNextPartials(next.candidates); });
   ASSERT_GE(ranges, 2u) << "the batch was not handed over in parts";
-  early->EvaluatePartials(next.candidates);
+  std::vector<std::size_t> skipped;
+  early->EvaluatePartials(next.candidates, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i)
+    {
+      const bool unused = next.folds[i].Folded() && !next.candidates[i].evaluateFolded;
+      if (!unused)
+        EXPECT_EQ(bounds[i].skipped, i % 4 != 3) << "candidate " << i;
+      if (bounds[i].skipped)
+      {
+        EXPECT_EQ(bounds[i].witness, 77u);
+        for (const TetrahedronValues & v : next.values[i])
+          EXPECT_EQ(v.intensity, 0.0);
+        skipped.push_back(i);
+      }
+    }
+    if (end == next.candidates.size()) // all handed over: sampled now
+      early->SampleSkipped(next.candidates, skipped);
+  });
   EXPECT_GT(early->Statistics().startedCandidates, 0u);
   EXPECT_LT(early->Statistics().startedCandidates, next.candidates.size());
+  EXPECT_GT(skipped.size(), next.candidates.size() / 2);
+  EXPECT_EQ(early->Statistics().boundSampledLater, skipped.size());
   late->EvaluatePartials(whole.candidates);
   EXPECT_EQ(late->Statistics().startedCandidates, 0u);
   std::size_t folded = 0;
@@ -698,9 +735,11 @@ TEST(CudaEvaluationBackend, CandidatesStartedEarlyGetTheValuesOfAWholeBatch)
   }
   EXPECT_GT(folded, 100u);
   // Outside the hand-over of a next-to-last part a start is ignored.
+  for (PartialCandidate & c : next.candidates)
+    c.bound = nullptr;
   const std::uint64_t started = early->Statistics().startedCandidates;
   early->PrepareNextPartials(whole.candidates);
-  early->StartNextPartials(whole.candidates, 10);
+  early->StartNextPartials(whole.candidates, 10, nullptr);
   early->EvaluatePartials(whole.candidates);
   EXPECT_EQ(early->Statistics().startedCandidates, started);
 }

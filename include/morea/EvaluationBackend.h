@@ -201,14 +201,18 @@ public:
    *  EvaluatePartials call (prepared with PrepareNextPartials) before the
    *  current call returns, when the current batch's acceptance can no longer
    *  change them: their parents' points, keys and `evaluateFolded` are
-   *  final. Heeded only from `ready` for the current call's next-to-last
-   *  range (the CUDA backend then checks their folds while the caller accepts
-   *  the last part); ignored otherwise and by default. */
+   *  final, and so are the bounds `screen` fills for them. Heeded only from
+   *  `ready` for the current call's next-to-last range (the CUDA backend
+   *  then checks their folds, builds, screens and sets up their sampling
+   *  while the caller accepts the last part); ignored otherwise and by
+   *  default. A started call screens all its candidates with `screen` (null:
+   *  none), not with the screen set when it is made. */
   virtual void
-  StartNextPartials(const std::vector<PartialCandidate> & next, std::size_t head)
+  StartNextPartials(const std::vector<PartialCandidate> & next, std::size_t head, const RefusalScreen * screen)
   {
     static_cast<void>(next);
     static_cast<void>(head);
+    static_cast<void>(screen);
   }
 
   /** Whether StartNextPartials would start a head now (from `ready`): the

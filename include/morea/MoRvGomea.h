@@ -242,6 +242,9 @@ private:
    *  archive without one). */
   bool
   Accepted(const Candidate & c, const Fitness & next, const Fitness & now, ArchiveVerdict * verdict) const;
+  /** The refusal screen of a batch: the archive now and its bounds' filling. */
+  RefusalScreen
+  ScreenFor(CandidateBatch & candidateBatch) const;
   /** Candidate i's refusal bound from its parent's state (RefusalScreen::fill). */
   void
   FillBound(CandidateBatch & candidateBatch, std::size_t i) const;

@@ -780,6 +780,18 @@ MoRvGomea::FillBound(CandidateBatch & candidateBatch, std::size_t i) const
   bound.parent = CurrentFitness(c.solution);
 }
 
+RefusalScreen
+MoRvGomea::ScreenFor(CandidateBatch & candidateBatch) const
+{
+  RefusalScreen screen;
+  screen.archive = m_Archive->Objectives();
+  screen.witnesses = m_Archive->Witnesses();
+  screen.tetrahedra = m_Topology.NumberOfTetrahedra();
+  screen.guidanceLimit = m_SteeringLimit;
+  screen.fill = [this, &candidateBatch](std::size_t i) { FillBound(candidateBatch, i); };
+  return screen;
+}
+
 std::size_t
 MoRvGomea::ProcessCandidates(CandidateBatch & candidateBatch, GenerationRecord & record,
                              const EvaluationBackend::Meanwhile & meanwhile, CandidateBatch * next)
@@ -819,7 +831,13 @@ MoRvGomea::ProcessCandidates(CandidateBatch & candidateBatch, GenerationRecord &
       while (head < next->candidates.size() && !pending[next->candidates[head].solution])
         ++head;
       SetParentState(*next, 0, head);
-      m_Backend.StartNextPartials(next->partials, head);
+      if (m_Options.boundRefusals)
+      {
+        const RefusalScreen screen = ScreenFor(*next);
+        m_Backend.StartNextPartials(next->partials, head, &screen);
+      }
+      else
+        m_Backend.StartNextPartials(next->partials, head, nullptr);
     }
     acceptanceSeconds += SecondsSince(phaseStart);
   };
@@ -832,13 +850,7 @@ MoRvGomea::ProcessCandidates(CandidateBatch & candidateBatch, GenerationRecord &
   };
   if (m_Options.boundRefusals)
   {
-    RefusalScreen screen;
-    screen.archive = m_Archive->Objectives();
-    screen.witnesses = m_Archive->Witnesses();
-    screen.tetrahedra = m_Topology.NumberOfTetrahedra();
-    screen.guidanceLimit = m_SteeringLimit;
-    screen.fill = [this, &candidateBatch](std::size_t i) { FillBound(candidateBatch, i); };
-    m_Backend.SetRefusalScreen(screen);
+    m_Backend.SetRefusalScreen(ScreenFor(candidateBatch));
   }
   else
     m_Backend.ClearRefusalScreen();

@@ -23,7 +23,7 @@ __global__ void
 GatherCandidateCorners(CandidateBatch b, FoldedCandidateSkip skip, double * corners, std::uint32_t * tetrahedra,
                        std::uint8_t * itemSkip)
 {
-  const std::size_t c = (static_cast<std::size_t>(blockIdx.x) * blockDim.x + threadIdx.x) / 32;
+  const std::size_t c = b.firstCandidate + (static_cast<std::size_t>(blockIdx.x) * blockDim.x + threadIdx.x) / 32;
   if (c >= b.candidates)
     return;
   const int           lane = static_cast<int>(threadIdx.x & 31);
@@ -84,7 +84,9 @@ LaunchGatherCandidateCorners(const CandidateBatch & batch, std::size_t items, co
     return;
   if ((skip.skipIfFolded == nullptr) != (skip.outcome == nullptr))
     throw Error("CUDA backend: skipping folded candidates needs both their flags and the fold checks' outcome");
-  const std::size_t warps = batch.candidates;
+  if (batch.firstCandidate >= batch.candidates)
+    return;
+  const std::size_t warps = batch.candidates - batch.firstCandidate;
   const unsigned    blocks = static_cast<unsigned>((warps * 32 + GatherThreads - 1) / GatherThreads);
   GatherCandidateCorners<<<blocks, GatherThreads, 0, static_cast<cudaStream_t>(stream)>>>(batch, skip, corners,
                                                                                         tetrahedra, itemSkip);

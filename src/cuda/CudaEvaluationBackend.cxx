@@ -111,6 +111,62 @@ struct HostCandidates
   cuda::PinnedArray<std::uint64_t> sideSeeds;               ///< per candidate side
 };
 
+/** Device and pinned buffers of one EvaluatePartials batch, and how it runs.
+ *  Two alternate, as HostCandidates do: the next batch's head fills one
+ *  while the current batch's values, corners and screen outcome are still
+ *  read from the other. A batch goes up in one or two candidate ranges (a
+ *  head started early, then the rest), each range in parts. Needs a device
+ *  (its events). */
+struct BatchFlight
+{
+  cuda::DeviceArray<double>        corners, itemValues, directionValues;
+  cuda::DeviceArray<std::uint32_t> tetrahedra;
+  cuda::DeviceArray<std::uint8_t>  itemSkip; ///< per item: ItemSkip
+  cuda::PinnedArray<double>        hostItemValues, hostDirectionValues;
+  cuda::DeviceArray<std::uint8_t>  outcome; ///< per candidate side: the fold checks' outcome
+  cuda::PinnedArray<std::uint8_t>  hostOutcome;
+  cuda::PinnedArray<std::uint32_t> hostChunks; ///< per part: the texture set-up's number of chunks
+  std::vector<std::unique_ptr<cuda::DeviceArray<unsigned char>>> workspaces, chunkWorkspaces; ///< per part
+
+  /** The refusal screen of the whole batch, as it was when the batch began. */
+  RefusalScreen                                screen;
+  bool                                         hasScreen{ false };
+  bool                                         screened{ false }; ///< hostRefusal holds every candidate's outcome
+  bool                                         archiveUploaded{ false };
+  cuda::PinnedArray<cuda::CandidateBoundInput> hostBounds;
+  cuda::DeviceArray<cuda::CandidateBoundInput> bounds;
+  cuda::PinnedArray<double>                    hostArchive;
+  cuda::DeviceArray<double>                    archive;
+  cuda::DeviceArray<std::uint32_t>             refusal; ///< see cuda::LaunchScreenCandidates
+  cuda::PinnedArray<std::uint32_t>             hostRefusal;
+
+  std::size_t items{ 0 };
+  bool        checks{ false }; ///< the fold kernel runs
+  bool        skipItems{ false }; ///< itemSkip is set (not for whole solutions)
+  // Ranges of candidates and parts of items; a range's parts follow it.
+  static constexpr std::size_t MaxRanges = 2;
+  std::size_t                  ranges{ 0 };
+  std::size_t                  rangeBegin[MaxRanges]{}, rangeEnd[MaxRanges]{}, rangeFirstPart[MaxRanges]{};
+  std::vector<std::size_t>     candidateBounds{ 0 }, itemBounds{ 0 }; ///< per part, and the end
+  std::size_t                  sampledParts{ 0 };                      ///< parts whose sampling is queued
+
+  cuda::Event start, staged, end;
+  cuda::Event rangeStart[MaxRanges], foldStart[MaxRanges], foldEnd[MaxRanges];
+  std::vector<std::unique_ptr<cuda::Event>> partEvents;   ///< per part: set-up start, end; sampling start, end
+  std::vector<std::unique_ptr<cuda::Event>> copiedEvents; ///< per part: its values on the host
+
+  std::size_t
+  Parts() const
+  {
+    return candidateBounds.size() - 1;
+  }
+  cudaEvent_t
+  PartEvent(std::size_t p, int step) const
+  {
+    return partEvents[4 * p + static_cast<std::size_t>(step)]->Get();
+  }
+};
+
 /** Sets a flag for a scope, cleared however the scope is left. */
 class AcceptHeadScope
 {
@@ -143,16 +199,12 @@ public:
     m_Stream = std::make_unique<cuda::Stream>();
     m_CopyStream = std::make_unique<cuda::Stream>();
     m_FallbackStream = std::make_unique<cuda::Stream>(cuda::Stream::HighPriority{});
-    m_FoldStart = std::make_unique<cuda::Event>();
-    m_FoldEnd = std::make_unique<cuda::Event>();
-    m_BatchStart = std::make_unique<cuda::Event>();
-    m_BatchEnd = std::make_unique<cuda::Event>();
-    m_PreviousBatchEnd = std::make_unique<cuda::Event>();
-    m_Staged = std::make_unique<cuda::Event>();
-    m_NextBatchStart = std::make_unique<cuda::Event>();
-    m_NextStaged = std::make_unique<cuda::Event>();
-    m_NextFoldStart = std::make_unique<cuda::Event>();
-    m_HostChunks.Reserve(1);
+    for (auto & flight : m_Flights)
+    {
+      flight = std::make_unique<BatchFlight>();
+      // Once: parts' counts arrive asynchronously, so it must never move.
+      flight->hostChunks.Reserve(BatchFlight::MaxRanges * MaxParts);
+    }
     cuda::UploadSobolDirections(SobolDirectionNumbers());
 
     const ObjectiveData & data = evaluator.Data();
@@ -208,20 +260,27 @@ public:
       if (s->source.size() != points || s->target.size() != points)
         throw Error("evaluation backend: a solution does not match the mesh");
     const auto start = std::chrono::steady_clock::now();
-    Reserve(solutions.size() * n);
+    // The flight of the last batch, which is done: the other one may hold
+    // a started head.
+    BatchFlight &     f = *m_Flights[m_CurrentHost];
+    const std::size_t items = solutions.size() * n;
+    ReserveItems(f, items);
+    m_HostCorners.Reserve(items * cuda::ItemCorners);
+    m_HostTetrahedra.Reserve(items);
     m_Pool.ParallelFor(solutions.size(), [&](std::size_t s) {
       for (std::size_t t = 0; t < n; ++t)
         Pack(s * n + t, static_cast<std::uint32_t>(t), CornersOf(tets[t], solutions[s]->source),
              CornersOf(tets[t], solutions[s]->target));
     });
-    CopyCornersToDevice(solutions.size() * n);
-    Run(solutions.size() * n);
+    Check(cudaEventRecord(f.start.Get(), m_Stream->Get()), "recording an event");
+    CopyCornersToDevice(f, items);
+    RunWhole(f, items);
     std::vector<std::uint64_t> first(solutions.size() + 1);
     for (std::size_t s = 0; s <= solutions.size(); ++s)
       first[s] = s * n;
     for (auto * v : values)
       v->resize(n);
-    UnpackAll(first, [&](std::size_t s) { return values[s]->data(); });
+    UnpackRange(f, first.data(), 0, solutions.size(), [&](std::size_t s) { return values[s]->data(); });
     m_Statistics.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
 
@@ -272,121 +331,40 @@ public:
   EvaluatePartials(const std::vector<PartialCandidate> & candidates, const ReadyCandidates & ready,
                    const Meanwhile & meanwhile) override
   {
-    const auto       start = std::chrono::steady_clock::now();
-    HostCandidates & host = m_HostCandidates[1 - m_CurrentHost];
+    const auto        start = std::chrono::steady_clock::now();
+    const int         slot = 1 - m_CurrentHost;
+    HostCandidates &  host = m_HostCandidates[slot];
+    BatchFlight &     f = *m_Flights[slot];
     const std::size_t n = candidates.size();
     // Its first candidates may be on the device already (StartNextPartials).
     const bool started = m_Head.open && host.PackedFor(candidates);
+    if (m_Head.open && !started) // its queued work reads what is packed afresh now
+      Synchronize("abandoning a started batch");
     m_Head.open = false;
     std::size_t head = 0;
-    bool        checks = false;
     if (started)
     {
       head = m_Head.count;
-      checks = m_Head.checks;
-      std::swap(m_BatchStart, m_NextBatchStart);
-      std::swap(m_Staged, m_NextStaged);
-      std::swap(m_FoldStart, m_NextFoldStart);
-      CheckStartedHead(candidates, host, head);
+      CheckStartedHead(candidates, host, f, head);
       m_Statistics.startedCandidates += head;
     }
     else
     {
-      Check(cudaEventRecord(m_BatchStart->Get(), m_Stream->Get()), "recording an event");
       if (!host.PackedFor(candidates))
         PackCandidates(candidates, host);
+      BeginFlight(candidates, host, f, m_HasRefusalScreen ? &m_RefusalScreen : nullptr);
     }
     host.prepared = false;
-    m_CurrentHost = 1 - m_CurrentHost;
-    const std::size_t items = host.firstItem[n];
-    if (items > 0)
-    {
-      if (!started)
-        checks = UploadTables(candidates, host, *m_Staged);
-      // A started head's fold checks began the phase already.
-      UploadRange(candidates, host, head, n, checks, started ? nullptr : m_FoldStart.get());
-    }
-    else // (a started head has items)
-      Check(cudaEventRecord(m_Staged->Get(), m_Stream->Get()), "recording an event");
-    Check(cudaEventRecord(m_FoldEnd->Get(), m_Stream->Get()), "recording an event");
-    if (checks)
-      CopyFoldChecksBack(n, host);
-    if (items > 0)
-    {
-      Reserve(items);
-      m_ItemSkip.Reserve(items);
-      // Candidates left folded that need no values are not sampled (as on
-      // the CPU): late in a run, about a third of a batch's tetrahedra.
-      cuda::FoldedCandidateSkip skip;
-      if (checks)
-      {
-        skip.skipIfFolded = m_SkipIfFolded;
-        skip.outcome = m_Outcome.Data();
-      }
-      cuda::LaunchGatherCandidateCorners(m_Batch, items, skip, m_Corners.Data(), m_Tetrahedra.Data(),
-                                         m_ItemSkip.Data(), m_Stream->Get());
-    }
-    const bool screened = items > 0 && ScreenCandidates(candidates);
-    // Each candidate's first item, as packed.
-    const std::uint64_t * first = host.firstItem.Data();
-    // Parts of whole candidates with about equal numbers of items, the last
-    // one smaller.
-    const std::size_t        parts = std::clamp<std::size_t>(items / MinItemsPerPart, 1, MaxParts);
-    const double             shares = static_cast<double>(parts - 1) + LastPartShare;
-    std::vector<std::size_t> candidateBounds{ 0 }, itemBounds{ 0 };
-    for (std::size_t p = 1; p < parts; ++p)
-    {
-      const auto bound = static_cast<std::uint64_t>(static_cast<double>(p) / shares * static_cast<double>(items));
-      const auto it = std::lower_bound(first, first + candidates.size() + 1, bound);
-      const auto c = static_cast<std::size_t>(it - first);
-      if (c > candidateBounds.back() && c < candidates.size())
-      {
-        candidateBounds.push_back(c);
-        itemBounds.push_back(first[c]);
-      }
-    }
-    candidateBounds.push_back(candidates.size());
-    itemBounds.push_back(items);
+    m_CurrentHost = slot;
+    if (head < n || n == 0)
+      QueueRange(candidates, host, f, head, n, true);
     m_Statistics.stagingSeconds += SecondsSince(start);
-
-    bool          foldsRead = false;
-    std::uint64_t skippedItems = 0;
-    RunParts(itemBounds, m_ItemSkip.Data(), meanwhile, [&](std::size_t p) {
-      const auto unpack = std::chrono::steady_clock::now();
-      if (!foldsRead)
-      {
-        if (checks)
-          ReadFoldChecks(candidates, host);
-        else
-          for (const PartialCandidate & c : candidates)
-            if (c.folds)
-              *c.folds = CandidateFolds{}; // no dependent tetrahedra, nothing checked
-        foldsRead = true;
-      }
-      for (std::size_t i = candidateBounds[p]; i < candidateBounds[p + 1]; ++i)
-        if (Skipped(candidates[i]))
-          skippedItems += first[i + 1] - first[i];
-      const std::uint32_t * spared = screened ? m_HostScreenRefusal.Data() : nullptr;
-      const auto &          witnesses = m_RefusalScreen.witnesses;
-      UnpackRange(
-        first, candidateBounds[p], candidateBounds[p + 1],
-        [&](std::size_t i) -> TetrahedronValues * {
-          if (RefusalBound * bound = candidates[i].bound)
-          {
-            const std::uint32_t by = spared ? spared[i] : 0;
-            bound->skipped = by != 0;
-            bound->witness = by != 0 && by - 1 < witnesses.size() ? witnesses[by - 1] : 0;
-          }
-          return Skipped(candidates[i]) ? nullptr : candidates[i].values; // left alone, as on the CPU
-        },
-        spared);
-      m_Statistics.unpackSeconds += SecondsSince(unpack);
-      if (ready)
-        ready(candidateBounds[p], candidateBounds[p + 1]);
-    });
-    m_Statistics.tetrahedra -= skippedItems;
-    if (items > 0)
-      AddDevicePhases(checks, itemBounds.size() - 1);
+    // The caller's next batch is drawn while the device checks folds and sets
+    // the sampling up (the chunk counts are read after it).
+    if (meanwhile)
+      meanwhile();
+    QueueSampling(f);
+    Deliver(candidates, host, f, ready);
     m_Statistics.seconds += SecondsSince(start);
   }
 
@@ -400,10 +378,11 @@ public:
     m_Statistics.stagingSeconds += SecondsSince(start);
   }
 
-  /** Uploads the first `head` candidates of the prepared next batch with
-   *  their parents and queues their fold checks behind the current batch's
-   *  last part, so that the device checks them while the caller accepts that
-   *  part (only while the next-to-last part is handed over). */
+  /** Starts the first `head` candidates of the prepared next batch, behind
+   *  the current batch's last part: their parents go up, their folds are
+   *  checked, their corners built and screened and their sampling set up
+   *  (on the exact path, sampled too), while the caller accepts that part
+   *  (only while the next-to-last part is handed over). */
   bool
   WantsNextPartials() const override
   {
@@ -411,20 +390,23 @@ public:
   }
 
   void
-  StartNextPartials(const std::vector<PartialCandidate> & next, std::size_t head) override
+  StartNextPartials(const std::vector<PartialCandidate> & next, std::size_t head,
+                    const RefusalScreen * screen) override
   {
     if (!WantsNextPartials() || head == 0 || head > next.size())
       return;
-    HostCandidates & h = m_HostCandidates[1 - m_CurrentHost];
+    const int        slot = 1 - m_CurrentHost;
+    HostCandidates & h = m_HostCandidates[slot];
     if (!h.PackedFor(next) || h.firstItem[next.size()] == 0 || h.largestChecked > cuda::MaxRepairElementPoints)
       return;
-    const auto start = std::chrono::steady_clock::now();
-    Check(cudaEventRecord(m_NextBatchStart->Get(), m_Stream->Get()), "recording an event");
-    const bool checks = UploadTables(next, h, *m_NextStaged);
-    UploadRange(next, h, 0, head, checks, m_NextFoldStart.get());
+    const auto    start = std::chrono::steady_clock::now();
+    BatchFlight & f = *m_Flights[slot];
+    BeginFlight(next, h, f, screen);
+    QueueRange(next, h, f, 0, head, head == next.size());
+    if (!UsesTexturePath()) // no chunk counts to wait for
+      QueueSampling(f);
     m_Head.open = true;
     m_Head.count = head;
-    m_Head.checks = checks;
     m_Statistics.stagingSeconds += SecondsSince(start);
   }
 
@@ -443,6 +425,7 @@ public:
   {
     const auto                 start = std::chrono::steady_clock::now();
     const HostCandidates &     h = m_HostCandidates[m_CurrentHost];
+    const BatchFlight &        f = *m_Flights[m_CurrentHost];
     std::size_t                count = 0;
     for (std::size_t i : which)
     {
@@ -471,7 +454,7 @@ public:
         for (std::uint64_t item = h.firstItem[i]; item < h.firstItem[i + 1]; ++item)
           for (std::uint32_t direction = 0; direction < 2; ++direction)
           {
-            const double      n = m_HostDirectionValues[(2 * item + direction) * cuda::DirectionValues + 2];
+            const double      n = f.hostDirectionValues[(2 * item + direction) * cuda::DirectionValues + 2];
             const std::size_t chunks = (static_cast<std::size_t>(n) + chunkSamples - 1) / chunkSamples;
             for (std::size_t local = 0; local < chunks; ++local)
               list.insert(list.end(), { static_cast<std::uint32_t>(item), direction, static_cast<std::uint32_t>(local), 0u });
@@ -485,7 +468,7 @@ public:
       Check(cudaMemcpyAsync(m_FallbackList.Data(), m_HostFallbackList.Data(), list.size() * sizeof(std::uint32_t),
                             cudaMemcpyHostToDevice, stream),
             "copying skipped candidates to the device");
-      cuda::LaunchSampleListedChunks(m_Constants, m_Corners.Data(), m_FallbackList.Data(), entries,
+      cuda::LaunchSampleListedChunks(m_Constants, f.corners.Data(), m_FallbackList.Data(), entries,
                                      m_FallbackChunkSums.Data(), stream);
       Check(cudaMemcpyAsync(m_HostFallbackChunkSums.Data(), m_FallbackChunkSums.Data(), 2 * entries * sizeof(double),
                             cudaMemcpyDeviceToHost, stream),
@@ -520,7 +503,7 @@ public:
       Check(cudaMemcpyAsync(m_FallbackItems.Data(), m_HostFallbackItems.Data(), count * sizeof(std::uint64_t),
                             cudaMemcpyHostToDevice, stream),
             "copying skipped candidates to the device");
-      cuda::LaunchGatherItems(m_Corners.Data(), m_Tetrahedra.Data(), m_FallbackItems.Data(), count,
+      cuda::LaunchGatherItems(f.corners.Data(), f.tetrahedra.Data(), m_FallbackItems.Data(), count,
                               m_FallbackCorners.Data(), m_FallbackTetrahedra.Data(), stream);
       cuda::LaunchEvaluateTetrahedra(m_Constants, m_FallbackCorners.Data(), m_FallbackTetrahedra.Data(), nullptr,
                                      count, m_FallbackItemValues.Data(), m_FallbackDirectionValues.Data(), stream);
@@ -553,25 +536,24 @@ public:
   }
 
 private:
-  /** Queues the refusal screen of a batch whose corners are queued, when
-   *  the optimiser set one and bounds some candidate; its outcome reaches
-   *  m_HostScreenRefusal before the first part's values. */
-  bool
-  ScreenCandidates(const std::vector<PartialCandidate> & candidates)
+  /** Queues the refusal screen of candidates [range.firstCandidate,
+   *  range.candidates) of flight `f`, whose corners are queued, when the
+   *  batch has a screen; its outcome reaches f.hostRefusal before the
+   *  range's first part's values. */
+  void
+  ScreenRange(const std::vector<PartialCandidate> & candidates, BatchFlight & f, const cuda::CandidateBatch & range)
   {
-    if (!m_HasRefusalScreen)
-      return false;
-    const std::size_t n = candidates.size();
-    if (std::none_of(candidates.begin(), candidates.end(), [](const PartialCandidate & c) { return c.bound; }))
-      return false;
+    if (!f.hasScreen)
+      return;
+    const std::size_t begin = range.firstCandidate, end = range.candidates;
     // The bounds are filled here, while the device checks folds.
-    m_HostBounds.Reserve(n);
     std::atomic<bool> any{ false };
-    m_Pool.ParallelFor(n, [&](std::size_t i) {
+    m_Pool.ParallelFor(end - begin, [&](std::size_t k) {
+      const std::size_t         i = begin + k;
       const PartialCandidate &  c = candidates[i];
       cuda::CandidateBoundInput in{};
-      if (c.bound && m_RefusalScreen.fill)
-        m_RefusalScreen.fill(i);
+      if (c.bound && f.screen.fill)
+        f.screen.fill(i);
       if (c.bound && c.bound->screened)
       {
         const TetrahedronValues & r = c.bound->rest;
@@ -583,29 +565,39 @@ private:
         in.screened = 1;
         any.store(true, std::memory_order_relaxed);
       }
-      m_HostBounds[i] = in;
+      f.hostBounds[i] = in;
     });
     if (!any.load())
-      return false;
-    const std::vector<ObjectiveVector> & archive = m_RefusalScreen.archive;
-    m_HostArchive.Reserve(std::max<std::size_t>(1, 3 * archive.size()));
-    for (std::size_t e = 0; e < archive.size(); ++e)
-      std::copy(archive[e].begin(), archive[e].end(), m_HostArchive.Data() + 3 * e);
+    {
+      std::fill(f.hostRefusal.Data() + begin, f.hostRefusal.Data() + end, 0u);
+      return;
+    }
+    cudaStream_t stream = m_Stream->Get();
+    const std::vector<ObjectiveVector> & archive = f.screen.archive;
+    if (!f.archiveUploaded)
+    {
+      f.hostArchive.Reserve(std::max<std::size_t>(1, 3 * archive.size()));
+      for (std::size_t e = 0; e < archive.size(); ++e)
+        std::copy(archive[e].begin(), archive[e].end(), f.hostArchive.Data() + 3 * e);
+      UploadAsync(f.hostArchive.Data(), 3 * archive.size(), f.archive);
+      f.archiveUploaded = true;
+    }
+    Check(cudaMemcpyAsync(f.bounds.Data() + begin, f.hostBounds.Data() + begin,
+                          (end - begin) * sizeof(cuda::CandidateBoundInput), cudaMemcpyHostToDevice, stream),
+          "copying bounds to the device");
     cuda::RefusalScreenView view;
-    view.bounds = UploadAsync(m_HostBounds.Data(), n, m_Bounds);
-    view.archive = UploadAsync(m_HostArchive.Data(), 3 * archive.size(), m_Archive);
+    view.bounds = f.bounds.Data();
+    view.archive = f.archive.Data();
     view.archiveSize = static_cast<std::uint32_t>(archive.size());
-    view.tetrahedra = static_cast<double>(m_RefusalScreen.tetrahedra);
-    view.guidanceLimit = m_RefusalScreen.guidanceLimit;
+    view.tetrahedra = static_cast<double>(f.screen.tetrahedra);
+    view.guidanceLimit = f.screen.guidanceLimit;
     view.foldOffset = FoldConstraintOffset;
-    m_ScreenRefusal.Reserve(n);
-    m_HostScreenRefusal.Reserve(n);
-    cuda::LaunchScreenCandidates(m_Constants, m_Batch, m_Corners.Data(), m_Tetrahedra.Data(), view, m_ItemSkip.Data(),
-                                 m_ScreenRefusal.Data(), m_Stream->Get());
-    Check(cudaMemcpyAsync(m_HostScreenRefusal.Data(), m_ScreenRefusal.Data(), n * sizeof(std::uint32_t),
-                          cudaMemcpyDeviceToHost, m_Stream->Get()),
+    cuda::LaunchScreenCandidates(m_Constants, range, f.corners.Data(), f.tetrahedra.Data(), view, f.itemSkip.Data(),
+                                 f.refusal.Data(), stream);
+    Check(cudaMemcpyAsync(f.hostRefusal.Data() + begin, f.refusal.Data() + begin, (end - begin) * sizeof(std::uint32_t),
+                          cudaMemcpyDeviceToHost, stream),
           "copying the refusal screen from the device");
-    return true;
+    f.screened = true;
   }
 
   /** Left folded by the checks and needing no values: not sampled. */
@@ -846,8 +838,6 @@ private:
       m_HostSkipIfFolded.Reserve(n);
       m_SkipIfFoldedDevice.Reserve(n);
       m_SkipIfFolded = m_SkipIfFoldedDevice.Data();
-      m_Outcome.Reserve(2 * n);
-      m_HostOutcome.Reserve(2 * n);
     }
     return checks;
   }
@@ -859,9 +849,10 @@ private:
    *  whole batch is one range, or a head [0, h) the first call and the rest
    *  the second (the store's slots are assigned in two steps then). */
   void
-  UploadRange(const std::vector<PartialCandidate> & candidates, HostCandidates & h, std::size_t begin,
-              std::size_t end, bool checks, cuda::Event * foldStart)
+  UploadRange(const std::vector<PartialCandidate> & candidates, HostCandidates & h, BatchFlight & f,
+              std::size_t begin, std::size_t end, cuda::Event & foldStart)
   {
+    const bool checks = f.checks;
     // Parents are numbered by first use: those first used in the range are
     // consecutive.
     const auto        firstUse = h.parentFirstUse.begin();
@@ -887,8 +878,7 @@ private:
     Check(cudaMemcpyAsync(m_CandidateParent.Data() + begin, m_HostCandidateSlot.Data() + begin,
                           (end - begin) * sizeof(std::uint32_t), cudaMemcpyHostToDevice, stream),
           "copying a batch to the device");
-    if (foldStart)
-      Check(cudaEventRecord(foldStart->Get(), stream), "recording an event");
+    Check(cudaEventRecord(foldStart.Get(), stream), "recording an event");
     if (!checks)
       return;
     m_Pool.ParallelFor(end - begin, [&](std::size_t k) {
@@ -898,20 +888,21 @@ private:
     Check(cudaMemcpyAsync(m_SkipIfFoldedDevice.Data() + begin, m_HostSkipIfFolded.Data() + begin, end - begin,
                           cudaMemcpyHostToDevice, stream),
           "copying a batch to the device");
-    cuda::LaunchCheckCandidateFolds(m_Batch, m_Folds, m_FoldCheck, m_SideSeeds, m_Moved.Data(), m_Outcome.Data(),
+    cuda::LaunchCheckCandidateFolds(m_Batch, m_Folds, m_FoldCheck, m_SideSeeds, m_Moved.Data(), f.outcome.Data(),
                                     begin, end - begin, stream);
   }
 
   /** A started head must be what the call passes: the same parents' keys
    *  and the same candidates needing no values when left folded. */
   void
-  CheckStartedHead(const std::vector<PartialCandidate> & candidates, const HostCandidates & h, std::size_t head) const
+  CheckStartedHead(const std::vector<PartialCandidate> & candidates, const HostCandidates & h, const BatchFlight & f,
+                   std::size_t head) const
   {
     for (std::size_t i = 0; i < head; ++i)
     {
       const PartialCandidate & c = candidates[i];
       if (c.parentKey != m_ParentKeys[h.candidateParent[i]] ||
-          (m_Head.checks && m_HostSkipIfFolded[i] != (c.folds && !c.evaluateFolded ? 1 : 0)))
+          (f.checks && m_HostSkipIfFolded[i] != (c.folds && !c.evaluateFolded ? 1 : 0)))
         throw Error("evaluation backend: candidates started early changed before their evaluation");
     }
   }
@@ -957,32 +948,48 @@ private:
     cuda::LaunchScatterParents(staged, slotsOnDevice, count, perParent, m_Parents.Data(), m_Stream->Get());
   }
 
-  /** The fold checks' outcome and the repaired points back to the host,
-   *  after them (read when the first part is handed over). The checks run
-   *  on the sampling stream, before the corners: run part by part on a
-   *  second stream beside the sampling, the two kernels slowed each other
-   *  down more than they overlapped (H100, paper configuration: 192.9 s
-   *  against 184.2 s for 500 generations). */
+  /** The fold checks' outcome and the repaired points of range `r` back to
+   *  the host, after them (read when the range's first part is handed
+   *  over). The checks run on the sampling stream, before the corners: run
+   *  part by part on a second stream beside the sampling, the two kernels
+   *  slowed each other down more than they overlapped (H100, paper
+   *  configuration: 192.9 s against 184.2 s for 500 generations). */
   void
-  CopyFoldChecksBack(std::size_t candidates, HostCandidates & h)
+  CopyFoldChecksBack(HostCandidates & h, BatchFlight & f, std::size_t r)
   {
     // On the copy stream, so that the corners need not wait for the
-    // transfer; read after part 0's values, which follow on that stream.
-    cudaStream_t copies = m_CopyStream->Get();
-    Check(cudaStreamWaitEvent(copies, m_FoldEnd->Get(), 0), "ordering the fold checks' copy after them");
-    Check(cudaMemcpyAsync(m_HostOutcome.Data(), m_Outcome.Data(), 2 * candidates, cudaMemcpyDeviceToHost, copies),
+    // transfer; it goes before the range's values on that stream.
+    cudaStream_t      copies = m_CopyStream->Get();
+    const std::size_t begin = f.rangeBegin[r], end = f.rangeEnd[r];
+    Check(cudaStreamWaitEvent(copies, f.foldEnd[r].Get(), 0), "ordering the fold checks' copy after them");
+    Check(cudaMemcpyAsync(f.hostOutcome.Data() + 2 * begin, f.outcome.Data() + 2 * begin, 2 * (end - begin),
+                          cudaMemcpyDeviceToHost, copies),
           "copying fold checks from the device");
-    if (m_Folds.repair)
-      Check(cudaMemcpyAsync(h.moved.Data(), m_Moved.Data(), m_MovedCount * sizeof(double),
-                            cudaMemcpyDeviceToHost, copies),
-            "copying repaired points from the device");
+    if (!m_Folds.repair)
+      return;
+    const std::size_t n = h.signatures.size();
+    const std::size_t from = 6 * static_cast<std::size_t>(h.candidateMoved[begin]);
+    const std::size_t to = 6 * (end < n ? static_cast<std::size_t>(h.candidateMoved[end]) : h.movedPoints);
+    Check(cudaMemcpyAsync(h.moved.Data() + from, m_Moved.Data() + from, (to - from) * sizeof(double),
+                          cudaMemcpyDeviceToHost, copies),
+          "copying repaired points from the device");
   }
 
+  /** The fold outcome of range `r`'s candidates, their repaired points in place. */
   void
-  ReadFoldChecks(const std::vector<PartialCandidate> & candidates, const HostCandidates & h)
+  ReadFoldChecks(const std::vector<PartialCandidate> & candidates, const HostCandidates & h, const BatchFlight & f,
+                 std::size_t r)
   {
-    m_Statistics.foldSeconds += ElapsedSeconds(*m_FoldStart, *m_FoldEnd);
-    for (std::size_t i = 0; i < candidates.size(); ++i)
+    const std::size_t begin = f.rangeBegin[r], end = f.rangeEnd[r];
+    if (!f.checks)
+    {
+      for (std::size_t i = begin; i < end; ++i)
+        if (candidates[i].folds)
+          *candidates[i].folds = CandidateFolds{}; // no dependent tetrahedra, nothing checked
+      return;
+    }
+    m_Statistics.foldSeconds += ElapsedSeconds(f.foldStart[r], f.foldEnd[r]);
+    for (std::size_t i = begin; i < end; ++i)
     {
       const PartialCandidate & c = candidates[i];
       if (!c.folds)
@@ -990,7 +997,7 @@ private:
       CandidateFolds folds;
       for (int side = 0; side < 2; ++side)
       {
-        const std::uint8_t outcome = m_HostOutcome[2 * i + side];
+        const std::uint8_t outcome = f.hostOutcome[2 * i + side];
         if (!(outcome & cuda::SideFolded))
           continue;
         ++folds.foldedSides;
@@ -1035,31 +1042,32 @@ private:
     return m_Constants.packed && m_Constants.interpolation == cuda::Interpolation::Texture;
   }
 
+  /** Items of whole solutions (m_HostCorners, m_HostTetrahedra) to flight `f`. */
   void
-  CopyCornersToDevice(std::size_t items)
+  CopyCornersToDevice(BatchFlight & f, std::size_t items)
   {
     if (items == 0)
       return;
     cudaStream_t stream = m_Stream->Get();
-    Check(cudaMemcpyAsync(m_Corners.Data(), m_HostCorners.Data(), items * cuda::ItemCorners * sizeof(double),
+    Check(cudaMemcpyAsync(f.corners.Data(), m_HostCorners.Data(), items * cuda::ItemCorners * sizeof(double),
                           cudaMemcpyHostToDevice, stream),
           "copying corners to the device");
-    Check(cudaMemcpyAsync(m_Tetrahedra.Data(), m_HostTetrahedra.Data(), items * sizeof(std::uint32_t),
+    Check(cudaMemcpyAsync(f.tetrahedra.Data(), m_HostTetrahedra.Data(), items * sizeof(std::uint32_t),
                           cudaMemcpyHostToDevice, stream),
           "copying tetrahedron indices to the device");
   }
 
+  /** Room for `items` items in flight `f` (and for whole solutions' corners). */
   void
-  Reserve(std::size_t items)
+  ReserveItems(BatchFlight & f, std::size_t items)
   {
-    m_HostCorners.Reserve(items * cuda::ItemCorners);
-    m_HostTetrahedra.Reserve(items);
-    m_HostItemValues.Reserve(items * cuda::ItemValues);
-    m_HostDirectionValues.Reserve(items * 2 * cuda::DirectionValues);
-    m_Corners.Reserve(items * cuda::ItemCorners);
-    m_Tetrahedra.Reserve(items);
-    m_ItemValues.Reserve(items * cuda::ItemValues);
-    m_DirectionValues.Reserve(items * 2 * cuda::DirectionValues);
+    f.corners.Reserve(items * cuda::ItemCorners);
+    f.tetrahedra.Reserve(items);
+    f.itemSkip.Reserve(items);
+    f.itemValues.Reserve(items * cuda::ItemValues);
+    f.directionValues.Reserve(items * 2 * cuda::DirectionValues);
+    f.hostItemValues.Reserve(items * cuda::ItemValues);
+    f.hostDirectionValues.Reserve(items * 2 * cuda::DirectionValues);
   }
 
   void
@@ -1075,11 +1083,11 @@ private:
     m_HostTetrahedra[item] = t;
   }
 
-  TetrahedronValues
-  Unpack(std::size_t item) const
+  static TetrahedronValues
+  Unpack(const BatchFlight & f, std::size_t item)
   {
-    const double *    v = m_HostItemValues.Data() + item * cuda::ItemValues;
-    const double *    d = m_HostDirectionValues.Data() + item * 2 * cuda::DirectionValues;
+    const double *    v = f.hostItemValues.Data() + item * cuda::ItemValues;
+    const double *    d = f.hostDirectionValues.Data() + item * 2 * cuda::DirectionValues;
     TetrahedronValues out;
     out.magnitude = v[0];
     out.foldValue = v[1];
@@ -1093,8 +1101,14 @@ private:
   static double
   ElapsedSeconds(const cuda::Event & from, const cuda::Event & to)
   {
+    return ElapsedSeconds(from.Get(), to.Get());
+  }
+
+  static double
+  ElapsedSeconds(cudaEvent_t from, cudaEvent_t to)
+  {
     float milliseconds = 0.0f;
-    Check(cudaEventElapsedTime(&milliseconds, from.Get(), to.Get()), "reading an event");
+    Check(cudaEventElapsedTime(&milliseconds, from, to), "reading an event");
     return 1e-3 * milliseconds;
   }
 
@@ -1104,26 +1118,31 @@ private:
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
 
-  /** Adds the last batch's phases to the statistics (see
-   *  BackendStatistics::DevicePhases); `checks`: whether the fold kernel ran. */
+  /** Adds flight `f`'s phases to the statistics (see
+   *  BackendStatistics::DevicePhases). */
   void
-  AddDevicePhases(bool checks, std::size_t parts)
+  AddDevicePhases(const BatchFlight & f)
   {
-    auto &     phases = m_Statistics.devicePhases;
-    const auto part = [&](std::size_t p, int step) -> const cuda::Event & { return *m_PartEvents[4 * p + step]; };
-    if (m_HasPreviousBatch)
-      phases.betweenBatches += ElapsedSeconds(*m_PreviousBatchEnd, *m_BatchStart);
-    phases.staging += ElapsedSeconds(*m_BatchStart, *m_Staged);
-    const double fold = checks ? ElapsedSeconds(*m_FoldStart, *m_FoldEnd) : 0.0;
-    phases.uploads += ElapsedSeconds(*m_Staged, *m_FoldEnd) - fold;
-    phases.foldChecks += fold;
-    const cuda::Event & prepared = UsesTexturePath() ? part(parts - 1, 1) : part(0, 2);
-    phases.preparation += ElapsedSeconds(*m_FoldEnd, prepared);
-    if (UsesTexturePath())
-      phases.chunkCounts += ElapsedSeconds(prepared, part(0, 2));
-    phases.sampling += ElapsedSeconds(part(0, 2), *m_BatchEnd);
-    std::swap(m_PreviousBatchEnd, m_BatchEnd);
-    m_HasPreviousBatch = true;
+    auto &            phases = m_Statistics.devicePhases;
+    const std::size_t parts = f.Parts();
+    double            folds = 0.0, uploads = ElapsedSeconds(f.staged, f.rangeStart[0]);
+    for (std::size_t r = 0; r < f.ranges; ++r)
+    {
+      const double fold = f.checks ? ElapsedSeconds(f.foldStart[r], f.foldEnd[r]) : 0.0;
+      folds += fold;
+      uploads += ElapsedSeconds(f.rangeStart[r], f.foldEnd[r]) - fold;
+    }
+    const double span = ElapsedSeconds(f.start, f.end);
+    const double staging = ElapsedSeconds(f.start, f.staged);
+    const double chunkCounts = UsesTexturePath() ? ElapsedSeconds(f.PartEvent(parts - 1, 1), f.PartEvent(0, 2)) : 0.0;
+    const double sampling = ElapsedSeconds(f.PartEvent(0, 2), f.end.Get());
+    phases.staging += staging;
+    phases.uploads += uploads;
+    phases.foldChecks += folds;
+    phases.chunkCounts += chunkCounts;
+    phases.sampling += sampling;
+    // Corners, screen and set-up, and whatever the device waited for between the ranges.
+    phases.preparation += std::max(0.0, span - staging - uploads - folds - chunkCounts - sampling);
   }
 
   /** Waits for the stream, counting the host's waiting time. */
@@ -1136,142 +1155,287 @@ private:
   }
 
   void
-  Run(std::size_t items)
+  WaitFor(cudaEvent_t event, const char * what)
   {
-    RunParts({ 0, items }, nullptr, Meanwhile{}, [](std::size_t) {});
+    const auto start = std::chrono::steady_clock::now();
+    Check(cudaEventSynchronize(event), what);
+    m_Statistics.waitSeconds += SecondsSince(start);
   }
 
-  /** Evaluates items [bounds[p], bounds[p + 1]) part after part and calls
-   *  done(p), in order, once part p's values are on the host, while the
-   *  device samples the later parts. Items whose `itemSkip` byte is set
-   *  (null: none) are not sampled. `meanwhile` (if set) runs once every
-   *  part's kernels are queued. */
+  /** Starts a batch of partial candidates on flight `f`: its tables go up,
+   *  after f.start and f.staged; `screen` (if any) screens all its ranges. */
   void
-  RunParts(const std::vector<std::size_t> & bounds, const std::uint8_t * itemSkip, const Meanwhile & meanwhile,
-           const std::function<void(std::size_t)> & done)
+  BeginFlight(const std::vector<PartialCandidate> & candidates, HostCandidates & h, BatchFlight & f,
+              const RefusalScreen * screen)
   {
-    const std::size_t parts = bounds.size() - 1;
-    const std::size_t items = bounds.back();
-    if (items == 0)
+    const std::size_t n = candidates.size();
+    Check(cudaEventRecord(f.start.Get(), m_Stream->Get()), "recording an event");
+    f.items = h.firstItem[n];
+    f.checks = f.items > 0 && UploadTables(candidates, h, f.staged);
+    if (f.items == 0)
+      Check(cudaEventRecord(f.staged.Get(), m_Stream->Get()), "recording an event");
+    f.skipItems = true;
+    ReserveItems(f, f.items);
+    if (f.checks)
     {
-      Check(cudaEventRecord(m_BatchEnd->Get(), m_Stream->Get()), "recording an event");
-      Check(cudaEventSynchronize(m_BatchEnd->Get()), "waiting for the batch");
-      if (meanwhile)
-        meanwhile();
-      for (std::size_t p = 0; p < parts; ++p)
-        done(p);
+      f.outcome.Reserve(2 * n);
+      f.hostOutcome.Reserve(2 * n);
+    }
+    f.ranges = 0;
+    f.candidateBounds.assign(1, 0);
+    f.itemBounds.assign(1, 0);
+    f.sampledParts = 0;
+    f.hasScreen = screen && std::any_of(candidates.begin(), candidates.end(),
+                                        [](const PartialCandidate & c) { return c.bound; });
+    f.screened = false;
+    f.archiveUploaded = false;
+    if (f.hasScreen)
+    {
+      f.screen = *screen;
+      f.hostBounds.Reserve(std::max<std::size_t>(1, n));
+      f.bounds.Reserve(std::max<std::size_t>(1, n));
+      f.refusal.Reserve(std::max<std::size_t>(1, n));
+      f.hostRefusal.Reserve(std::max<std::size_t>(1, n));
+    }
+  }
+
+  /** Queues candidates [begin, end) of the batch begun on flight `f`: their
+   *  parents, fold checks (and the outcome's copy back), corners, screen,
+   *  and the set-up of their parts' sampling (texture path). `last`: the
+   *  batch's last range, whose last part is smaller. */
+  void
+  QueueRange(const std::vector<PartialCandidate> & candidates, HostCandidates & h, BatchFlight & f, std::size_t begin,
+             std::size_t end, bool last)
+  {
+    if (f.ranges == BatchFlight::MaxRanges)
+      throw Error("CUDA backend: a batch goes up in at most two ranges");
+    cudaStream_t      stream = m_Stream->Get();
+    const std::size_t r = f.ranges++;
+    f.rangeBegin[r] = begin;
+    f.rangeEnd[r] = end;
+    f.rangeFirstPart[r] = f.Parts();
+    Check(cudaEventRecord(f.rangeStart[r].Get(), stream), "recording an event");
+    if (f.items > 0)
+    {
+      UploadRange(candidates, h, f, begin, end, f.foldStart[r]);
+      Check(cudaEventRecord(f.foldEnd[r].Get(), stream), "recording an event");
+      if (f.checks)
+        CopyFoldChecksBack(h, f, r);
+      // Candidates left folded that need no values are not sampled (as on
+      // the CPU): late in a run, about a third of a batch's tetrahedra.
+      cuda::FoldedCandidateSkip skip;
+      if (f.checks)
+      {
+        skip.skipIfFolded = m_SkipIfFolded;
+        skip.outcome = f.outcome.Data();
+      }
+      cuda::CandidateBatch range = m_Batch;
+      range.firstCandidate = begin;
+      range.candidates = end;
+      cuda::LaunchGatherCandidateCorners(range, f.items, skip, f.corners.Data(), f.tetrahedra.Data(),
+                                         f.itemSkip.Data(), stream);
+      ScreenRange(candidates, f, range);
+    }
+    else
+    {
+      Check(cudaEventRecord(f.foldStart[r].Get(), stream), "recording an event");
+      Check(cudaEventRecord(f.foldEnd[r].Get(), stream), "recording an event");
+    }
+    // Parts of whole candidates with about equal numbers of items, the
+    // batch's last one smaller.
+    const std::uint64_t * first = h.firstItem.Data();
+    const std::uint64_t   from = first[begin], count = first[end] - from;
+    const std::size_t     parts = std::clamp<std::size_t>(count / MinItemsPerPart, 1, MaxParts);
+    const double          shares = static_cast<double>(parts - 1) + (last ? LastPartShare : 1.0);
+    for (std::size_t p = 1; p < parts; ++p)
+    {
+      const auto bound = from + static_cast<std::uint64_t>(static_cast<double>(p) / shares * static_cast<double>(count));
+      const auto c = static_cast<std::size_t>(std::lower_bound(first + begin, first + end + 1, bound) - first);
+      if (c > f.candidateBounds.back() && c < end)
+      {
+        f.candidateBounds.push_back(c);
+        f.itemBounds.push_back(first[c]);
+      }
+    }
+    f.candidateBounds.push_back(end);
+    f.itemBounds.push_back(first[end]);
+    for (std::size_t p = f.rangeFirstPart[r]; p < f.Parts(); ++p)
+      PreparePart(f, p);
+  }
+
+  /** Events and, on the texture path, the sampling set-up of part `p`. */
+  void
+  PreparePart(BatchFlight & f, std::size_t p)
+  {
+    while (f.partEvents.size() < 4 * (p + 1))
+      f.partEvents.push_back(std::make_unique<cuda::Event>());
+    while (f.copiedEvents.size() < p + 1)
+      f.copiedEvents.push_back(std::make_unique<cuda::Event>());
+    while (f.workspaces.size() < p + 1)
+    {
+      f.workspaces.push_back(std::make_unique<cuda::DeviceArray<unsigned char>>());
+      f.chunkWorkspaces.push_back(std::make_unique<cuda::DeviceArray<unsigned char>>());
+    }
+    if (p >= BatchFlight::MaxRanges * MaxParts)
+      throw Error("CUDA backend: a batch in more parts than its ranges allow");
+    f.hostChunks[p] = 0; // stays 0 for a part without items
+    if (!UsesTexturePath())
       return;
-    }
-    cudaStream_t stream = m_Stream->Get(), copies = m_CopyStream->Get();
-    while (m_PartEvents.size() < 4 * parts) // per part: step 1 start, end; step 2 start, end
-      m_PartEvents.push_back(std::make_unique<cuda::Event>());
-    while (m_CopiedEvents.size() < parts)
-      m_CopiedEvents.push_back(std::make_unique<cuda::Event>());
-    const auto event = [&](std::size_t p, int step) { return m_PartEvents[4 * p + step]->Get(); };
-    const auto count = [&](std::size_t p) { return bounds[p + 1] - bounds[p]; };
-    // Texture path: step 1 of every part first. One synchronisation then
-    // gives every part's number of chunks, and the parts' step 2 run back to
-    // back while the host hands the earlier ones over. (With one
-    // synchronisation per part, the device waited whenever handing a part
-    // over took longer than sampling the next.)
-    std::vector<std::size_t> chunks(parts, 0), workspaceAt(parts + 1, 0), chunkWorkspaceAt(parts + 1, 0);
-    if (UsesTexturePath())
+    cudaStream_t      stream = m_Stream->Get();
+    const std::size_t begin = f.itemBounds[p], count = f.itemBounds[p + 1] - begin;
+    f.workspaces[p]->Reserve(std::max<std::size_t>(1, cuda::TexturePrepareWorkspaceBytes(count)));
+    Check(cudaEventRecord(f.PartEvent(p, 0), stream), "recording an event");
+    cuda::LaunchPrepareTexture(m_Constants, f.corners.Data() + begin * cuda::ItemCorners, f.tetrahedra.Data() + begin,
+                               f.skipItems ? f.itemSkip.Data() + begin : nullptr, count, f.workspaces[p]->Data(),
+                               f.itemValues.Data() + begin * cuda::ItemValues, f.hostChunks.Data() + p, stream);
+    Check(cudaEventRecord(f.PartEvent(p, 1), stream), "recording an event");
+  }
+
+  /** Queues the sampling of the parts of flight `f` not yet queued and their
+   *  values' copy to the host, then f.end. On the texture path it waits for
+   *  their set-up first: the number of chunks sizes the sampling. */
+  void
+  QueueSampling(BatchFlight & f)
+  {
+    const std::size_t parts = f.Parts();
+    cudaStream_t      stream = m_Stream->Get(), copies = m_CopyStream->Get();
+    if (UsesTexturePath() && f.sampledParts < parts)
+      WaitFor(f.PartEvent(parts - 1, 1), "preparing the texture sampling");
+    for (std::size_t p = f.sampledParts; p < parts; ++p)
     {
-      for (std::size_t p = 0; p < parts; ++p)
-        workspaceAt[p + 1] = workspaceAt[p] + (cuda::TexturePrepareWorkspaceBytes(count(p)) + 255) / 256 * 256;
-      m_Workspace.Reserve(workspaceAt[parts]);
-      m_HostChunks.Reserve(parts);
-      for (std::size_t p = 0; p < parts; ++p)
-      {
-        Check(cudaEventRecord(event(p, 0), stream), "recording an event");
-        cuda::LaunchPrepareTexture(m_Constants, m_Corners.Data() + bounds[p] * cuda::ItemCorners,
-                                   m_Tetrahedra.Data() + bounds[p], itemSkip ? itemSkip + bounds[p] : nullptr,
-                                   count(p), m_Workspace.Data() + workspaceAt[p],
-                                   m_ItemValues.Data() + bounds[p] * cuda::ItemValues, m_HostChunks.Data() + p,
-                                   stream);
-        Check(cudaEventRecord(event(p, 1), stream), "recording an event");
-      }
-      Synchronize("preparing the texture sampling");
-      for (std::size_t p = 0; p < parts; ++p)
-      {
-        chunks[p] = m_HostChunks[p];
-        chunkWorkspaceAt[p + 1] = chunkWorkspaceAt[p] + cuda::TextureChunkWorkspaceBytes(chunks[p]);
-      }
-      m_ChunkWorkspace.Reserve(chunkWorkspaceAt[parts]);
-    }
-    for (std::size_t p = 0; p < parts; ++p)
-    {
-      const std::size_t begin = bounds[p];
-      double *          itemValues = m_ItemValues.Data() + begin * cuda::ItemValues;
-      double *          directionValues = m_DirectionValues.Data() + begin * 2 * cuda::DirectionValues;
-      Check(cudaEventRecord(event(p, 2), stream), "recording an event");
+      const std::size_t begin = f.itemBounds[p], count = f.itemBounds[p + 1] - begin;
+      double *          itemValues = f.itemValues.Data() + begin * cuda::ItemValues;
+      double *          directionValues = f.directionValues.Data() + begin * 2 * cuda::DirectionValues;
       if (UsesTexturePath())
-        cuda::LaunchSampleTexture(m_Constants, count(p), m_Workspace.Data() + workspaceAt[p], chunks[p],
-                                  m_ChunkWorkspace.Data() + chunkWorkspaceAt[p], directionValues, stream);
+      {
+        const std::size_t chunks = f.hostChunks[p];
+        f.chunkWorkspaces[p]->Reserve(std::max<std::size_t>(1, cuda::TextureChunkWorkspaceBytes(chunks)));
+        Check(cudaEventRecord(f.PartEvent(p, 2), stream), "recording an event");
+        cuda::LaunchSampleTexture(m_Constants, count, f.workspaces[p]->Data(), chunks, f.chunkWorkspaces[p]->Data(),
+                                  directionValues, stream);
+      }
       else
-        cuda::LaunchEvaluateTetrahedra(m_Constants, m_Corners.Data() + begin * cuda::ItemCorners,
-                                       m_Tetrahedra.Data() + begin, itemSkip ? itemSkip + begin : nullptr, count(p),
-                                       itemValues, directionValues, stream);
-      Check(cudaEventRecord(event(p, 3), stream), "recording an event");
+      {
+        Check(cudaEventRecord(f.PartEvent(p, 2), stream), "recording an event");
+        cuda::LaunchEvaluateTetrahedra(m_Constants, f.corners.Data() + begin * cuda::ItemCorners,
+                                       f.tetrahedra.Data() + begin, f.skipItems ? f.itemSkip.Data() + begin : nullptr,
+                                       count, itemValues, directionValues, stream);
+      }
+      Check(cudaEventRecord(f.PartEvent(p, 3), stream), "recording an event");
       // The values go back on the copy stream, so that the next part's
       // kernels do not wait for the transfer (about 70 bytes per tetrahedron).
-      Check(cudaStreamWaitEvent(copies, event(p, 3), 0), "ordering a copy after its part");
-      Check(cudaMemcpyAsync(m_HostItemValues.Data() + begin * cuda::ItemValues, itemValues,
-                            count(p) * cuda::ItemValues * sizeof(double), cudaMemcpyDeviceToHost, copies),
+      Check(cudaStreamWaitEvent(copies, f.PartEvent(p, 3), 0), "ordering a copy after its part");
+      Check(cudaMemcpyAsync(f.hostItemValues.Data() + begin * cuda::ItemValues, itemValues,
+                            count * cuda::ItemValues * sizeof(double), cudaMemcpyDeviceToHost, copies),
             "copying values from the device");
-      Check(cudaMemcpyAsync(m_HostDirectionValues.Data() + begin * 2 * cuda::DirectionValues, directionValues,
-                            count(p) * 2 * cuda::DirectionValues * sizeof(double), cudaMemcpyDeviceToHost, copies),
+      Check(cudaMemcpyAsync(f.hostDirectionValues.Data() + begin * 2 * cuda::DirectionValues, directionValues,
+                            count * 2 * cuda::DirectionValues * sizeof(double), cudaMemcpyDeviceToHost, copies),
             "copying values from the device");
-      Check(cudaEventRecord(m_CopiedEvents[p]->Get(), copies), "recording an event");
+      Check(cudaEventRecord(f.copiedEvents[p]->Get(), copies), "recording an event");
     }
-    Check(cudaEventRecord(m_BatchEnd->Get(), stream), "recording an event");
-    // Drawn here rather than before the chunk counts are read, where it
-    // held the sampling up whenever it outlasted the fold checks and set-up
-    // (H100, generations 341-500: 0.2072-0.2077 s there, 0.2062-0.2068 s here).
-    if (meanwhile)
-      meanwhile();
-    // Part p's values on the host, then done(p), while later parts sample.
+    f.sampledParts = parts;
+    Check(cudaEventRecord(f.end.Get(), stream), "recording an event");
+  }
+
+  /** Hands the parts of flight `f` over in order as their values arrive:
+   *  fold outcomes, values (or bounds), then ready(). */
+  void
+  Deliver(const std::vector<PartialCandidate> & candidates, const HostCandidates & h, const BatchFlight & f,
+          const ReadyCandidates & ready)
+  {
+    const std::size_t     parts = f.Parts();
+    const std::uint64_t * first = h.firstItem.Data();
+    const std::uint32_t * spared = f.screened ? f.hostRefusal.Data() : nullptr;
+    const auto &          witnesses = f.screen.witnesses;
+    std::uint64_t         skippedItems = 0;
     for (std::size_t p = 0; p < parts; ++p)
     {
-      const auto start = std::chrono::steady_clock::now();
-      Check(cudaEventSynchronize(m_CopiedEvents[p]->Get()), "copying values from the device");
-      m_Statistics.waitSeconds += SecondsSince(start);
+      WaitFor(f.copiedEvents[p]->Get(), "copying values from the device");
+      if (p == 0 && f.items > 0)
+      {
+        // Before ready() may start the next batch on the other flight.
+        if (m_PreviousFlight)
+          m_Statistics.devicePhases.betweenBatches += ElapsedSeconds(m_PreviousFlight->end, f.start);
+      }
+      const auto unpack = std::chrono::steady_clock::now();
+      for (std::size_t r = 0; r < f.ranges; ++r)
+        if (f.rangeFirstPart[r] == p)
+          ReadFoldChecks(candidates, h, f, r);
+      const std::size_t begin = f.candidateBounds[p], end = f.candidateBounds[p + 1];
+      for (std::size_t i = begin; i < end; ++i)
+        if (Skipped(candidates[i]))
+          skippedItems += first[i + 1] - first[i];
+      UnpackRange(
+        f, first, begin, end,
+        [&](std::size_t i) -> TetrahedronValues * {
+          if (RefusalBound * bound = candidates[i].bound)
+          {
+            const std::uint32_t by = spared ? spared[i] : 0;
+            bound->skipped = by != 0;
+            bound->witness = by != 0 && by - 1 < witnesses.size() ? witnesses[by - 1] : 0;
+          }
+          return Skipped(candidates[i]) ? nullptr : candidates[i].values; // left alone, as on the CPU
+        },
+        spared);
+      m_Statistics.unpackSeconds += SecondsSince(unpack);
       // The caller may start the next batch's head while handing over the
       // next-to-last part: it runs behind the last one.
-      {
-        const AcceptHeadScope scope(m_AcceptHead, p + 2 == parts);
-        done(p);
-      }
+      const AcceptHeadScope scope(m_AcceptHead, p + 2 == parts);
+      if (ready)
+        ready(begin, end);
     }
     // The batch's end, not the stream's: a started head may follow it.
-    const auto end = std::chrono::steady_clock::now();
-    Check(cudaEventSynchronize(m_BatchEnd->Get()), "evaluating tetrahedra");
-    m_Statistics.waitSeconds += SecondsSince(end);
-    for (std::size_t p = 0; p < parts; ++p)
+    WaitFor(f.end.Get(), "evaluating tetrahedra");
+    AddKernelSeconds(f);
+    ++m_Statistics.batches;
+    m_Statistics.tetrahedra += f.items - skippedItems;
+    if (f.items > 0)
+    {
+      AddDevicePhases(f);
+      m_PreviousFlight = &f;
+    }
+  }
+
+  void
+  AddKernelSeconds(const BatchFlight & f)
+  {
+    for (std::size_t p = 0; p < f.Parts(); ++p)
     {
       if (UsesTexturePath())
-        m_Statistics.kernelSeconds += ElapsedSeconds(*m_PartEvents[4 * p], *m_PartEvents[4 * p + 1]);
-      m_Statistics.kernelSeconds += ElapsedSeconds(*m_PartEvents[4 * p + 2], *m_PartEvents[4 * p + 3]);
+        m_Statistics.kernelSeconds += ElapsedSeconds(f.PartEvent(p, 0), f.PartEvent(p, 1));
+      m_Statistics.kernelSeconds += ElapsedSeconds(f.PartEvent(p, 2), f.PartEvent(p, 3));
     }
+  }
+
+  /** Evaluates `items` items of whole solutions, their corners in flight
+   *  `f` already, in one part, and waits for their values. */
+  void
+  RunWhole(BatchFlight & f, std::size_t items)
+  {
+    f.skipItems = false;
+    f.items = items;
+    f.ranges = 0;
+    f.candidateBounds.assign({ 0, 0 });
+    f.itemBounds.assign({ 0, items });
+    f.sampledParts = 0;
+    PreparePart(f, 0);
+    QueueSampling(f);
+    WaitFor(f.copiedEvents[0]->Get(), "evaluating tetrahedra");
+    WaitFor(f.end.Get(), "evaluating tetrahedra");
+    AddKernelSeconds(f);
     ++m_Statistics.batches;
     m_Statistics.tetrahedra += items;
+    m_PreviousFlight = nullptr; // its end is not a batch's
   }
 
-  /** Unpacks items [first[i], first[i + 1]) into out(i) for every i on the
-   *  pool, counting the samples on the way. */
+  /** Unpacks items [first[i], first[i + 1]) of flight `f` into out(i) for
+   *  every i in [begin, end) on the pool, counting the samples on the way; a
+   *  group whose out(i) is null is left alone. Groups whose `spared` entry
+   *  is set (null: none) were not sampled (refusal bound): their samples
+   *  count as spared. */
   template <typename Output>
   void
-  UnpackAll(const std::vector<std::uint64_t> & first, Output out)
-  {
-    UnpackRange(first.data(), 0, first.size() - 1, out);
-  }
-
-  /** UnpackAll for groups [begin, end) only; a group whose out(i) is null
-   *  is left alone. Groups whose `spared` byte is set (null: none) were not
-   *  sampled (refusal bound): their samples count as spared. */
-  template <typename Output>
-  void
-  UnpackRange(const std::uint64_t * first, std::size_t begin, std::size_t end, Output out,
+  UnpackRange(const BatchFlight & f, const std::uint64_t * first, std::size_t begin, std::size_t end, Output out,
               const std::uint32_t * spared = nullptr)
   {
     std::vector<double> samples(end - begin, 0.0);
@@ -1282,7 +1446,7 @@ private:
         return;
       for (std::size_t item = first[i]; item < first[i + 1]; ++item)
       {
-        *o = Unpack(item);
+        *o = Unpack(f, item);
         samples[g] += o->samples;
         ++o;
       }
@@ -1301,24 +1465,14 @@ private:
   ThreadPool                    m_Pool;
   std::unique_ptr<cuda::Stream> m_Stream;
   std::unique_ptr<cuda::Stream> m_CopyStream; ///< the parts' values back to the host
-  std::unique_ptr<cuda::Event>  m_FoldStart, m_FoldEnd;
-  std::unique_ptr<cuda::Event>  m_BatchStart, m_BatchEnd; ///< an EvaluatePartials batch on the device
-  std::unique_ptr<cuda::Event>  m_Staged;           ///< recorded before the batch's first upload
-  std::unique_ptr<cuda::Event>  m_NextBatchStart, m_NextStaged, m_NextFoldStart; ///< of a started head
-  std::unique_ptr<cuda::Event>  m_PreviousBatchEnd; ///< the last batch's end, if m_HasPreviousBatch
-  bool                          m_HasPreviousBatch{ false };
-  std::vector<std::unique_ptr<cuda::Event>> m_PartEvents;   ///< each part's kernels: start, end
-  std::vector<std::unique_ptr<cuda::Event>> m_CopiedEvents; ///< each part's values on the host
+  std::unique_ptr<BatchFlight>  m_Flights[2]; ///< as m_HostCandidates: the batch in flight, the next one
+  const BatchFlight *           m_PreviousFlight{ nullptr }; ///< the last batch handed over, for its end
   cuda::EvaluationConstants     m_Constants;
   cuda::DeviceArray<float>      m_Moving, m_Fixed, m_PackedMoving, m_PackedFixed;
   VolumeTextures m_MovingTextures, m_FixedTextures;
   cuda::DeviceArray<double>     m_GuidanceWeights, m_Elasticity, m_ReferenceVolumes;
-  cuda::DeviceArray<double>     m_Corners, m_ItemValues, m_DirectionValues;
-  cuda::DeviceArray<std::uint32_t> m_Tetrahedra;
-  cuda::PinnedArray<double>        m_HostCorners, m_HostItemValues, m_HostDirectionValues;
-  cuda::PinnedArray<std::uint32_t> m_HostTetrahedra;
-  cuda::DeviceArray<unsigned char> m_Workspace, m_ChunkWorkspace;
-  cuda::PinnedArray<std::uint32_t> m_HostChunks; ///< step 1's number of chunks
+  cuda::PinnedArray<double>        m_HostCorners;    ///< whole solutions' items
+  cuda::PinnedArray<std::uint32_t> m_HostTetrahedra; ///< whole solutions' items
   // Partial candidates: the mesh once, then per batch (device and staging).
   cuda::CandidateBatch             m_Batch;
   cuda::DeviceArray<std::uint32_t> m_Mesh, m_ElementPointOffsets, m_ElementPoints, m_ElementTetrahedronOffsets,
@@ -1335,7 +1489,6 @@ private:
   {
     bool        open{ false };
     std::size_t count{ 0 };
-    bool        checks{ false };
   } m_Head;
   bool m_AcceptHead{ false }; ///< StartNextPartials may start a head now
   cuda::PinnedArray<std::uint32_t> m_HostElementPointOffsets, m_HostElementPoints, m_HostElementTetrahedronOffsets,
@@ -1352,18 +1505,11 @@ private:
   const std::uint8_t *             m_FoldCheck{ nullptr };
   const std::uint8_t *             m_SkipIfFolded{ nullptr }; ///< per candidate: left folded, it needs no values
   const std::uint64_t *            m_SideSeeds{ nullptr };
-  cuda::DeviceArray<std::uint8_t>  m_FoldCheckDevice, m_SkipIfFoldedDevice, m_Outcome;
-  cuda::DeviceArray<std::uint8_t>  m_ItemSkip; ///< per item of a batch: not sampled
+  cuda::DeviceArray<std::uint8_t>  m_FoldCheckDevice, m_SkipIfFoldedDevice;
   cuda::DeviceArray<std::uint64_t> m_SideSeedsDevice;
-  cuda::PinnedArray<std::uint8_t>  m_HostSkipIfFolded, m_HostOutcome;
-  // The refusal screen (RefusalBound.h) per batch, and the sampling of the
-  // candidates it skipped that the optimiser needs after all.
-  cuda::PinnedArray<cuda::CandidateBoundInput> m_HostBounds;
-  cuda::DeviceArray<cuda::CandidateBoundInput> m_Bounds;
-  cuda::PinnedArray<double>                    m_HostArchive;
-  cuda::DeviceArray<double>                    m_Archive;
-  cuda::DeviceArray<std::uint32_t>             m_ScreenRefusal; ///< see LaunchScreenCandidates
-  cuda::PinnedArray<std::uint32_t>             m_HostScreenRefusal;
+  cuda::PinnedArray<std::uint8_t>  m_HostSkipIfFolded;
+  // The sampling of the candidates a refusal screen skipped that the
+  // optimiser needs after all.
   std::unique_ptr<cuda::Stream>                m_FallbackStream;
   cuda::PinnedArray<std::uint64_t>             m_HostFallbackItems;
   cuda::DeviceArray<std::uint64_t>             m_FallbackItems;

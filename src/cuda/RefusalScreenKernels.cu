@@ -76,7 +76,7 @@ ScreenCandidates(EvaluationConstants k, CandidateBatch batch, const double * __r
                  const std::uint32_t * __restrict__ tetrahedra, RefusalScreenView screen, std::uint8_t * itemSkip,
                  std::uint32_t * refusal)
 {
-  const std::size_t c = (static_cast<std::size_t>(blockIdx.x) * blockDim.x + threadIdx.x) / 32;
+  const std::size_t c = batch.firstCandidate + (static_cast<std::size_t>(blockIdx.x) * blockDim.x + threadIdx.x) / 32;
   if (c >= batch.candidates)
     return;
   const int                 lane = static_cast<int>(threadIdx.x & 31);
@@ -153,9 +153,9 @@ LaunchScreenCandidates(const EvaluationConstants & constants, const CandidateBat
                        const std::uint32_t * tetrahedra, const RefusalScreenView & screen, std::uint8_t * itemSkip,
                        std::uint32_t * refusal, void * stream)
 {
-  if (batch.candidates == 0)
+  if (batch.firstCandidate >= batch.candidates)
     return;
-  const std::size_t threads = 32 * batch.candidates;
+  const std::size_t threads = 32 * (batch.candidates - batch.firstCandidate);
   const unsigned    blocks = static_cast<unsigned>((threads + ScreenThreads - 1) / ScreenThreads);
   ScreenCandidates<<<blocks, ScreenThreads, 0, static_cast<cudaStream_t>(stream)>>>(constants, batch, corners,
                                                                                     tetrahedra, screen, itemSkip,

@@ -104,6 +104,9 @@ struct CandidateBatch
   const std::uint32_t * candidateMoved{ nullptr };            ///< first moved point per candidate
   const std::uint64_t * candidateFirstItem{ nullptr };        ///< per candidate, plus one (= items)
   std::size_t           candidates{ 0 };
+  /** The corner gathering and the refusal screen take candidates
+   *  [firstCandidate, candidates) only: a batch may go up in ranges. */
+  std::size_t           firstCandidate{ 0 };
   const double *        moved{ nullptr }; ///< moved point m: source at 6 m, target at 6 m + 3
 };
 
