@@ -16,7 +16,7 @@
 #                  does both on the GPU machine.
 #   Kernels of several builds: bench/run-device-benchmark.sh early OUTDIR GENERATIONS ROUNDS
 #                  BACKEND PROGRAM... times early generations from scratch, programs in turns.
-#   Refusal bound: bench/run-device-benchmark.sh bound OUTDIR SECONDS BACKEND GENERATIONS [ROUNDS]
+#   Refusal bound: bench/run-device-benchmark.sh bound OUTDIR SECONDS BACKEND GENERATIONS [ROUNDS [PROGRAM...]]
 #                  times late generations with --refusal-bound on and off in turns.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -166,32 +166,39 @@ case "${1:-}" in
     ;;
   bound)
     # The refusal bound on and off over the same late generations: the
-    # bundle's morea registers for SECONDS, then `morea benchmark` times
-    # GENERATIONS from that checkpoint on BACKEND with --refusal-bound on and
-    # off in turns, ROUNDS times (OUTDIR/BACKEND-on|off-ROUND.json).
+    # bundle's morea registers for SECONDS, then `morea benchmark` of each
+    # PROGRAM (default: the bundle's morea) times GENERATIONS from that
+    # checkpoint on BACKEND with --refusal-bound on and off in turns, ROUNDS
+    # times (OUTDIR/[PROGRAM-]BACKEND-on|off-ROUND.json).
     out=${2:?output folder}
     seconds=${3:?seconds of the start}
     backend=${4:?backend}
     generations=${5:?generations}
     rounds=${6:-1}
+    shift $(( $# < 6 ? $# : 6 ))
+    programs=("$@")
+    [ ${#programs[@]} -gt 0 ] || programs=(/tmp/b/bin/morea)
     mkdir -p "$out" /tmp/ab
     unpack_bundle
     rm -rf /tmp/ab/bound
     register /tmp/b/bin/morea /tmp/ab/bound "$seconds" cuda-texture || true
     for round in $(seq "$rounds"); do
-      for bound in on off; do
-        name="$backend-$bound-$round"
-        /tmp/b/bin/morea benchmark "${PROBLEM[@]}" --backends "$backend" --generations "$generations" \
-          --cpu-generations "$generations" --threads 16 --probe 0 --refusal-bound "$bound" \
-          --from-checkpoint /tmp/ab/bound/checkpoint.bin -o "$out/$name.json" > "$out/$name.log" 2>&1
-        summary "$out/$name.json" "$backend" "$name"
+      for program in "${programs[@]}"; do
+        for bound in on off; do
+          name="$backend-$bound-$round"
+          [ ${#programs[@]} -eq 1 ] || name="$(basename "$program")-$name"
+          "$program" benchmark "${PROBLEM[@]}" --backends "$backend" --generations "$generations" \
+            --cpu-generations "$generations" --threads 16 --probe 0 --refusal-bound "$bound" \
+            --from-checkpoint /tmp/ab/bound/checkpoint.bin -o "$out/$name.json" > "$out/$name.log" 2>&1
+          summary "$out/$name.json" "$backend" "$name"
+        done
       done
     done
     ;;
   *)
     echo "usage: $0 bundle | run OUTDIR [morea benchmark options] | register OUTDIR RUNDIR [SECONDS [BACKEND]]" \
       "| ab OUTDIR SECONDS BACKEND PROGRAM... | late OUTDIR SECONDS BACKEND [GENERATIONS]" \
-      "| early OUTDIR GENERATIONS ROUNDS BACKEND PROGRAM... | bound OUTDIR SECONDS BACKEND GENERATIONS [ROUNDS]" >&2
+      "| early OUTDIR GENERATIONS ROUNDS BACKEND PROGRAM... | bound OUTDIR SECONDS BACKEND GENERATIONS [ROUNDS [PROGRAM...]]" >&2
     exit 2
     ;;
 esac

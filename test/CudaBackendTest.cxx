@@ -411,6 +411,42 @@ TEST(CudaEvaluationBackend, TextureInterpolationStaysCloseToTheCpu)
   }
 }
 
+// The texture path sizes each part's sampling without waiting for its number
+// of chunks; a part with more than the room guessed is sampled again when
+// handed over, to the same values as with room enough.
+TEST(CudaEvaluationBackend, PartsWithMoreChunksThanGuessedAreSampledAgain)
+{
+  MOREA_REQUIRE_CUDA_DEVICE();
+  OptimiserTestProblem problem;
+  GomeaOptions         options = problem.Options(9);
+  options.populationSize = 2;
+  const auto                     population = problem.InitialPopulation(options);
+  auto                           cpu = CreateCpuEvaluationBackend(*problem.evaluator, 2);
+  std::vector<TetrahedronValues> plain;
+  cpu->EvaluateSolutions({ &population[0] }, { &plain });
+  double samples = 0.0;
+  for (const TetrahedronValues & v : plain)
+    samples += v.samples;
+  // About 16 chunks of 512 samples per tetrahedron, more than the first guess.
+  problem.data.samplingRate *= 16.0 * 512.0 / (samples / static_cast<double>(plain.size()));
+  auto texture = CreateCudaEvaluationBackend(*problem.evaluator, 2, CudaInterpolation::Texture);
+  std::vector<TetrahedronValues> first, second;
+  texture->EvaluateSolutions({ &population[0] }, { &first });
+  EXPECT_EQ(texture->Statistics().partsSampledAgain, 1u);
+  texture->EvaluateSolutions({ &population[0] }, { &second });
+  EXPECT_EQ(texture->Statistics().partsSampledAgain, 1u) << "room for all the second time";
+  ASSERT_EQ(first.size(), second.size());
+  double intensity = 0.0;
+  for (std::size_t t = 0; t < first.size(); ++t)
+  {
+    ASSERT_EQ(first[t].intensity, second[t].intensity) << "tetrahedron " << t;
+    ASSERT_EQ(first[t].guidance, second[t].guidance) << "tetrahedron " << t;
+    ASSERT_EQ(first[t].samples, second[t].samples) << "tetrahedron " << t;
+    intensity += first[t].intensity;
+  }
+  EXPECT_GT(intensity, 0.0);
+}
+
 // Tetrahedra of more than 512 samples are sampled in whole chunks whose
 // lanes take the points in another order (cosets of an index subspace). On
 // voxel noise, every tetrahedron's sum must match the CPU's points; as a
@@ -693,6 +729,7 @@ TEST(CudaEvaluationBackend, CandidatesStartedEarlyGetTheValuesOfAWholeBatch)
     [&] { early->PrepareNextPartials(next.candidates); });
   ASSERT_GE(ranges, 2u) << "the batch was not handed over in parts";
   std::vector<std::size_t> skipped;
+  std::size_t              witnessed = 0;
   early->EvaluatePartials(next.candidates, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i)
     {
@@ -701,7 +738,7 @@ TEST(CudaEvaluationBackend, CandidatesStartedEarlyGetTheValuesOfAWholeBatch)
         EXPECT_EQ(bounds[i].skipped, i % 4 != 3) << "candidate " << i;
       if (bounds[i].skipped)
       {
-        EXPECT_EQ(bounds[i].witness, 77u);
+        witnessed += bounds[i].witness == 77u ? 1 : 0; // 0: refused as infeasible (folded)
         for (const TetrahedronValues & v : next.values[i])
           EXPECT_EQ(v.intensity, 0.0);
         skipped.push_back(i);
@@ -713,6 +750,7 @@ TEST(CudaEvaluationBackend, CandidatesStartedEarlyGetTheValuesOfAWholeBatch)
   EXPECT_GT(early->Statistics().startedCandidates, 0u);
   EXPECT_LT(early->Statistics().startedCandidates, next.candidates.size());
   EXPECT_GT(skipped.size(), next.candidates.size() / 2);
+  EXPECT_GT(witnessed, skipped.size() / 2) << "the entry that refused them";
   EXPECT_EQ(early->Statistics().boundSampledLater, skipped.size());
   late->EvaluatePartials(whole.candidates);
   EXPECT_EQ(late->Statistics().startedCandidates, 0u);

@@ -94,6 +94,9 @@ struct BackendStatistics
   /** CUDA only: candidates evaluated after their upload and fold checks had
    *  started early (StartNextPartials). */
   std::uint64_t startedCandidates{ 0 };
+  /** CUDA only: parts sampled a second time, having more chunks than the
+   *  room guessed for them. */
+  std::uint64_t partsSampledAgain{ 0 };
   /** Candidates whose refusal bound spared their sampling, the samples they
    *  would have drawn (not in `samples`), and those sampled later after all
    *  (SampleSkipped: their samples are in `samples`). */
@@ -203,8 +206,8 @@ public:
    *  change them: their parents' points, keys and `evaluateFolded` are
    *  final, and so are the bounds `screen` fills for them. Heeded only from
    *  `ready` for the current call's next-to-last range (the CUDA backend
-   *  then checks their folds, builds, screens and sets up their sampling
-   *  while the caller accepts the last part); ignored otherwise and by
+   *  then checks their folds, builds, screens and samples them while the
+   *  caller accepts the last part); ignored otherwise and by
    *  default. A started call screens all its candidates with `screen` (null:
    *  none), not with the screen set when it is made. */
   virtual void

@@ -44,6 +44,8 @@ using cuda::Check;
 constexpr std::size_t MaxParts = 4;
 constexpr std::size_t MinItemsPerPart = 100000;
 constexpr double      LastPartShare = 0.5;
+// Room for this many times the most chunks per item seen so far.
+constexpr double ChunkRoomMargin = 1.25;
 
 /** The texture path's textures of one image. */
 struct VolumeTextures
@@ -149,6 +151,7 @@ struct BatchFlight
   std::size_t                  rangeBegin[MaxRanges]{}, rangeEnd[MaxRanges]{}, rangeFirstPart[MaxRanges]{};
   std::vector<std::size_t>     candidateBounds{ 0 }, itemBounds{ 0 }; ///< per part, and the end
   std::size_t                  sampledParts{ 0 };                      ///< parts whose sampling is queued
+  std::vector<std::size_t>     chunkCapacity; ///< per part: room for chunks (texture path)
 
   cuda::Event start, staged, end;
   cuda::Event rangeStart[MaxRanges], foldStart[MaxRanges], foldEnd[MaxRanges];
@@ -358,12 +361,10 @@ public:
     m_CurrentHost = slot;
     if (head < n || n == 0)
       QueueRange(candidates, host, f, head, n, true);
+    QueueSampling(f);
     m_Statistics.stagingSeconds += SecondsSince(start);
-    // The caller's next batch is drawn while the device checks folds and sets
-    // the sampling up (the chunk counts are read after it).
     if (meanwhile)
       meanwhile();
-    QueueSampling(f);
     Deliver(candidates, host, f, ready);
     m_Statistics.seconds += SecondsSince(start);
   }
@@ -380,9 +381,9 @@ public:
 
   /** Starts the first `head` candidates of the prepared next batch, behind
    *  the current batch's last part: their parents go up, their folds are
-   *  checked, their corners built and screened and their sampling set up
-   *  (on the exact path, sampled too), while the caller accepts that part
-   *  (only while the next-to-last part is handed over). */
+   *  checked, their corners built and screened and they are sampled, while
+   *  the caller accepts that part (only while the next-to-last part is
+   *  handed over). */
   bool
   WantsNextPartials() const override
   {
@@ -403,8 +404,7 @@ public:
     BatchFlight & f = *m_Flights[slot];
     BeginFlight(next, h, f, screen);
     QueueRange(next, h, f, 0, head, head == next.size());
-    if (!UsesTexturePath()) // no chunk counts to wait for
-      QueueSampling(f);
+    QueueSampling(f);
     m_Head.open = true;
     m_Head.count = head;
     m_Statistics.stagingSeconds += SecondsSince(start);
@@ -1292,15 +1292,16 @@ private:
   }
 
   /** Queues the sampling of the parts of flight `f` not yet queued and their
-   *  values' copy to the host, then f.end. On the texture path it waits for
-   *  their set-up first: the number of chunks sizes the sampling. */
+   *  values' copy to the host, then f.end. On the texture path the host does
+   *  not wait for the parts' numbers of chunks: each part gets room for the
+   *  most chunks per item seen so far, and one with more is sampled again
+   *  when handed over (CompleteOverflowingPart). */
   void
   QueueSampling(BatchFlight & f)
   {
     const std::size_t parts = f.Parts();
     cudaStream_t      stream = m_Stream->Get(), copies = m_CopyStream->Get();
-    if (UsesTexturePath() && f.sampledParts < parts)
-      WaitFor(f.PartEvent(parts - 1, 1), "preparing the texture sampling");
+    f.chunkCapacity.resize(parts, 0);
     for (std::size_t p = f.sampledParts; p < parts; ++p)
     {
       const std::size_t begin = f.itemBounds[p], count = f.itemBounds[p + 1] - begin;
@@ -1308,10 +1309,11 @@ private:
       double *          directionValues = f.directionValues.Data() + begin * 2 * cuda::DirectionValues;
       if (UsesTexturePath())
       {
-        const std::size_t chunks = f.hostChunks[p];
-        f.chunkWorkspaces[p]->Reserve(std::max<std::size_t>(1, cuda::TextureChunkWorkspaceBytes(chunks)));
+        const auto capacity = static_cast<std::size_t>(std::ceil(m_ChunksPerItem * static_cast<double>(count))) + 1024;
+        f.chunkCapacity[p] = capacity;
+        f.chunkWorkspaces[p]->Reserve(cuda::TextureChunkWorkspaceBytes(capacity));
         Check(cudaEventRecord(f.PartEvent(p, 2), stream), "recording an event");
-        cuda::LaunchSampleTexture(m_Constants, count, f.workspaces[p]->Data(), chunks, f.chunkWorkspaces[p]->Data(),
+        cuda::LaunchSampleTexture(m_Constants, count, f.workspaces[p]->Data(), capacity, f.chunkWorkspaces[p]->Data(),
                                   directionValues, stream);
       }
       else
@@ -1337,10 +1339,38 @@ private:
     Check(cudaEventRecord(f.end.Get(), stream), "recording an event");
   }
 
+  /** Part `p` of flight `f`, whose values are on the host, sampled again
+   *  where it had more chunks than room for them; and the room of later
+   *  parts made enough for it. */
+  void
+  CompleteOverflowingPart(BatchFlight & f, std::size_t p)
+  {
+    if (!UsesTexturePath())
+      return;
+    const std::size_t begin = f.itemBounds[p], count = f.itemBounds[p + 1] - begin;
+    const std::size_t chunks = f.hostChunks[p];
+    if (count > 0)
+      m_ChunksPerItem = std::max(m_ChunksPerItem, ChunkRoomMargin * static_cast<double>(chunks) / static_cast<double>(count));
+    if (chunks <= f.chunkCapacity[p])
+      return;
+    // Rare: once early in a run. The part's set-up is still in its workspace.
+    cudaStream_t stream = m_FallbackStream->Get();
+    double *     directionValues = f.directionValues.Data() + begin * 2 * cuda::DirectionValues;
+    f.chunkWorkspaces[p]->Reserve(cuda::TextureChunkWorkspaceBytes(chunks));
+    f.chunkCapacity[p] = chunks;
+    cuda::LaunchSampleTexture(m_Constants, count, f.workspaces[p]->Data(), chunks, f.chunkWorkspaces[p]->Data(),
+                              directionValues, stream);
+    Check(cudaMemcpyAsync(f.hostDirectionValues.Data() + begin * 2 * cuda::DirectionValues, directionValues,
+                          count * 2 * cuda::DirectionValues * sizeof(double), cudaMemcpyDeviceToHost, stream),
+          "copying values from the device");
+    Check(cudaStreamSynchronize(stream), "sampling a part again");
+    ++m_Statistics.partsSampledAgain;
+  }
+
   /** Hands the parts of flight `f` over in order as their values arrive:
    *  fold outcomes, values (or bounds), then ready(). */
   void
-  Deliver(const std::vector<PartialCandidate> & candidates, const HostCandidates & h, const BatchFlight & f,
+  Deliver(const std::vector<PartialCandidate> & candidates, const HostCandidates & h, BatchFlight & f,
           const ReadyCandidates & ready)
   {
     const std::size_t     parts = f.Parts();
@@ -1351,6 +1381,7 @@ private:
     for (std::size_t p = 0; p < parts; ++p)
     {
       WaitFor(f.copiedEvents[p]->Get(), "copying values from the device");
+      CompleteOverflowingPart(f, p);
       if (p == 0 && f.items > 0)
       {
         // Before ready() may start the next batch on the other flight.
@@ -1421,6 +1452,7 @@ private:
     PreparePart(f, 0);
     QueueSampling(f);
     WaitFor(f.copiedEvents[0]->Get(), "evaluating tetrahedra");
+    CompleteOverflowingPart(f, 0);
     WaitFor(f.end.Get(), "evaluating tetrahedra");
     AddKernelSeconds(f);
     ++m_Statistics.batches;
@@ -1467,6 +1499,7 @@ private:
   std::unique_ptr<cuda::Stream> m_CopyStream; ///< the parts' values back to the host
   std::unique_ptr<BatchFlight>  m_Flights[2]; ///< as m_HostCandidates: the batch in flight, the next one
   const BatchFlight *           m_PreviousFlight{ nullptr }; ///< the last batch handed over, for its end
+  double                        m_ChunksPerItem{ 6.0 }; ///< room for chunks per item: the most seen, with a margin
   cuda::EvaluationConstants     m_Constants;
   cuda::DeviceArray<float>      m_Moving, m_Fixed, m_PackedMoving, m_PackedFixed;
   VolumeTextures m_MovingTextures, m_FixedTextures;

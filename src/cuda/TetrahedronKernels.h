@@ -193,9 +193,13 @@ LaunchPrepareTexture(const EvaluationConstants & constants, const double * corne
                      const std::uint8_t * itemSkip, std::size_t items, void * workspace, double * itemOut, std::uint32_t * totalChunks,
                      void * stream);
 
+/** Step 2 for at most `chunkCapacity` chunks (`chunkWorkspace` sized for
+ *  them): the number step 1 found is read on the device, so that the host
+ *  need not wait for it. Where it is larger (step 1's `totalChunks` says
+ *  so), the sums are wrong: call again with room for all. */
 void
-LaunchSampleTexture(const EvaluationConstants & constants, std::size_t items, void * workspace, std::size_t chunks,
-                    void * chunkWorkspace, double * directionOut, void * stream);
+LaunchSampleTexture(const EvaluationConstants & constants, std::size_t items, void * workspace,
+                    std::size_t chunkCapacity, void * chunkWorkspace, double * directionOut, void * stream);
 
 /** Samples chunks of the texture path one by one: entry i of `list` (4
  *  integers: item, direction, the chunk's place among the direction's

@@ -298,8 +298,8 @@ GatherScheduleCounts(const std::uint32_t * __restrict__ sortedItems, const std::
  *  chunks begin. */
 __global__ void
 ScatterChunkTasks(const std::uint32_t * __restrict__ sortedItems, const std::uint32_t * __restrict__ scheduleCounts,
-                  const std::uint32_t * __restrict__ scheduleEnds, std::size_t tasks, std::uint32_t * taskFirstChunk,
-                  std::uint32_t * chunkTask)
+                  const std::uint32_t * __restrict__ scheduleEnds, std::size_t tasks, std::size_t capacity,
+                  std::uint32_t * taskFirstChunk, std::uint32_t * chunkTask)
 {
   const std::size_t position = static_cast<std::size_t>(blockIdx.x) * blockDim.x + threadIdx.x;
   if (position >= tasks)
@@ -308,7 +308,7 @@ ScatterChunkTasks(const std::uint32_t * __restrict__ sortedItems, const std::uin
   const std::uint32_t end = scheduleEnds[position];
   const std::uint32_t first = end - scheduleCounts[position];
   taskFirstChunk[task] = first;
-  for (std::uint32_t c = first; c < end; ++c)
+  for (std::uint32_t c = first; c < end && c < capacity; ++c)
     chunkTask[c] = task;
 }
 
@@ -545,10 +545,12 @@ SampleChunk(const SamplingConstants & k, const ChunkHeader & h, std::size_t chun
 __global__ void __launch_bounds__(SampleWarpsPerBlock * 32, 4)
 SampleTextureChunks(SamplingConstants k, const SampleTask * __restrict__ tasks,
                     const std::uint32_t * __restrict__ taskFirstChunk, const std::uint32_t * __restrict__ chunkTask,
-                    std::size_t chunks, double2 * chunkSums)
+                    const std::uint32_t * __restrict__ totalChunks, std::size_t capacity, double2 * chunkSums)
 {
   __shared__ float4 corners[SampleWarpsPerBlock][2][6];
   const int         warp = static_cast<int>(threadIdx.x / 32), lane = static_cast<int>(threadIdx.x & 31);
+  // The grid is sized for the capacity: warps past the chunks found leave.
+  const std::size_t chunks = min(static_cast<std::size_t>(__ldg(totalChunks)), capacity);
   const std::size_t first = 2 * ((static_cast<std::size_t>(blockIdx.x) * blockDim.x + threadIdx.x) / 32);
   if (first >= chunks) // whole warps leave together
     return;
@@ -612,14 +614,15 @@ SampleListedChunks(SamplingConstants s, EvaluationConstants k, const double * __
 __global__ void
 SumChunks(const SampleTask * __restrict__ tasks, const std::uint32_t * __restrict__ chunkCounts,
           const std::uint32_t * __restrict__ taskFirstChunk, const double2 * __restrict__ chunkSums,
-          std::size_t tasksCount, double * directionOut)
+          std::size_t tasksCount, std::size_t capacity, double * directionOut)
 {
   const std::size_t task = static_cast<std::size_t>(blockIdx.x) * blockDim.x + threadIdx.x;
   if (task >= tasksCount)
     return;
   const std::uint32_t first = taskFirstChunk[task];
   double              intensity = 0.0, guidance = 0.0;
-  for (std::uint32_t c = first; c < first + chunkCounts[task]; ++c)
+  // Past the capacity the sums are wrong anyway (the caller samples again).
+  for (std::uint32_t c = first; c < first + chunkCounts[task] && c < capacity; ++c)
   {
     const double2 s = chunkSums[c];
     intensity += s.x;
@@ -764,8 +767,8 @@ LaunchPrepareTexture(const EvaluationConstants & constants, const double * corne
 }
 
 void
-LaunchSampleTexture(const EvaluationConstants & constants, std::size_t items, void * workspace, std::size_t chunks,
-                    void * chunkWorkspace, double * directionOut, void * stream)
+LaunchSampleTexture(const EvaluationConstants & constants, std::size_t items, void * workspace,
+                    std::size_t chunkCapacity, void * chunkWorkspace, double * directionOut, void * stream)
 {
   if (items == 0)
     return;
@@ -773,23 +776,24 @@ LaunchSampleTexture(const EvaluationConstants & constants, std::size_t items, vo
   const PrepareWorkspace w = Partition(workspace, items);
   auto *                 chunkSums = static_cast<double2 *>(chunkWorkspace);
   auto * chunkTask = reinterpret_cast<std::uint32_t *>(static_cast<unsigned char *>(chunkWorkspace) +
-                                                       Aligned(chunks * sizeof(double2)));
+                                                       Aligned(chunkCapacity * sizeof(double2)));
   const std::size_t tasks = 2 * items;
   const unsigned    taskBlocks = static_cast<unsigned>((tasks + 255) / 256);
-  ScatterChunkTasks<<<taskBlocks, 256, 0, s>>>(w.sortedItems, w.scheduleCounts, w.scheduleEnds, tasks,
+  ScatterChunkTasks<<<taskBlocks, 256, 0, s>>>(w.sortedItems, w.scheduleCounts, w.scheduleEnds, tasks, chunkCapacity,
                                                w.taskFirstChunk, chunkTask);
   Check(cudaGetLastError(), "launching the chunk scatter kernel");
 
   const SamplingConstants k = SamplingConstantsOf(constants);
-  if (chunks > 0)
+  if (chunkCapacity > 0)
   {
-    const std::size_t warps = (chunks + 1) / 2;
+    const std::size_t warps = (chunkCapacity + 1) / 2;
     const unsigned    sampleBlocks = static_cast<unsigned>((warps + SampleWarpsPerBlock - 1) / SampleWarpsPerBlock);
-    SampleTextureChunks<<<sampleBlocks, SampleWarpsPerBlock * 32, 0, s>>>(k, w.tasks, w.taskFirstChunk, chunkTask,
-                                                                          chunks, chunkSums);
+    SampleTextureChunks<<<sampleBlocks, SampleWarpsPerBlock * 32, 0, s>>>(
+      k, w.tasks, w.taskFirstChunk, chunkTask, w.scheduleEnds + tasks - 1, chunkCapacity, chunkSums);
     Check(cudaGetLastError(), "launching the texture sampling kernel");
   }
-  SumChunks<<<taskBlocks, 256, 0, s>>>(w.tasks, w.chunkCounts, w.taskFirstChunk, chunkSums, tasks, directionOut);
+  SumChunks<<<taskBlocks, 256, 0, s>>>(w.tasks, w.chunkCounts, w.taskFirstChunk, chunkSums, tasks, chunkCapacity,
+                                       directionOut);
   Check(cudaGetLastError(), "launching the chunk sum kernel");
 }
 void
