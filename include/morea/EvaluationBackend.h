@@ -115,9 +115,9 @@ struct BackendStatistics
     double staging{ 0.0 };        ///< start to the first upload: the host packing the batch
     double uploads{ 0.0 };        ///< fold-check staging, candidates and parents to the device
     double foldChecks{ 0.0 };     ///< checks and repair
-    double preparation{ 0.0 };    ///< corners and the sampling set-up of all parts
-    double chunkCounts{ 0.0 };    ///< the host reading the chunk counts, queueing the sampling
-    double sampling{ 0.0 };       ///< the first sampling kernel's start to the batch's end
+    double preparation{ 0.0 };    ///< corners, screen, sampling set-up, and waits between ranges
+    double chunkCounts{ 0.0 };    ///< 0: the sampling is sized on the device (once the host read chunk counts)
+    double sampling{ 0.0 };       ///< the parts' sampling kernels
   } devicePhases;
 
   /** CUDA only: device time from each EvaluatePartials batch's start to its

@@ -1134,15 +1134,15 @@ private:
     }
     const double span = ElapsedSeconds(f.start, f.end);
     const double staging = ElapsedSeconds(f.start, f.staged);
-    const double chunkCounts = UsesTexturePath() ? ElapsedSeconds(f.PartEvent(parts - 1, 1), f.PartEvent(0, 2)) : 0.0;
-    const double sampling = ElapsedSeconds(f.PartEvent(0, 2), f.end.Get());
+    double       sampling = 0.0;
+    for (std::size_t p = 0; p < parts; ++p)
+      sampling += ElapsedSeconds(f.PartEvent(p, 2), f.PartEvent(p, 3));
     phases.staging += staging;
     phases.uploads += uploads;
     phases.foldChecks += folds;
-    phases.chunkCounts += chunkCounts;
     phases.sampling += sampling;
     // Corners, screen and set-up, and whatever the device waited for between the ranges.
-    phases.preparation += std::max(0.0, span - staging - uploads - folds - chunkCounts - sampling);
+    phases.preparation += std::max(0.0, span - staging - uploads - folds - sampling);
   }
 
   /** Waits for the stream, counting the host's waiting time. */
