@@ -3,8 +3,9 @@
 // the mesh and per-tetrahedron constants are uploaded once. A batch of
 // partial candidates (all candidates of a parallel group of a cluster) goes
 // up as its parents' points, its elements and the moved points; the device
-// builds every dependent tetrahedron's corners, evaluates all of them at once
-// and the values come back: one host-device synchronisation per call.
+// builds every dependent tetrahedron's corners, evaluates them part by part
+// and the values come back as each part is done. The next batch's candidates
+// whose parents are final may start while the current one is handed over.
 #include "morea/EvaluationBackend.h"
 
 #include "DeviceMemory.h"
@@ -275,7 +276,6 @@ public:
         Pack(s * n + t, static_cast<std::uint32_t>(t), CornersOf(tets[t], solutions[s]->source),
              CornersOf(tets[t], solutions[s]->target));
     });
-    Check(cudaEventRecord(f.start.Get(), m_Stream->Get()), "recording an event");
     CopyCornersToDevice(f, items);
     RunWhole(f, items);
     std::vector<std::uint64_t> first(solutions.size() + 1);
@@ -1382,12 +1382,9 @@ private:
     {
       WaitFor(f.copiedEvents[p]->Get(), "copying values from the device");
       CompleteOverflowingPart(f, p);
-      if (p == 0 && f.items > 0)
-      {
-        // Before ready() may start the next batch on the other flight.
-        if (m_PreviousFlight)
-          m_Statistics.devicePhases.betweenBatches += ElapsedSeconds(m_PreviousFlight->end, f.start);
-      }
+      // Read before ready() may start the next batch on the previous flight.
+      if (p == 0 && f.items > 0 && m_PreviousFlight)
+        m_Statistics.devicePhases.betweenBatches += ElapsedSeconds(m_PreviousFlight->end, f.start);
       const auto unpack = std::chrono::steady_clock::now();
       for (std::size_t r = 0; r < f.ranges; ++r)
         if (f.rangeFirstPart[r] == p)
