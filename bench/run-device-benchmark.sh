@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The CUDA benchmark on a GPU machine without ITK (see README.md, "CUDA backend").
-#   Here:          bench/run-device-benchmark.sh bundle
-#                  builds morea and the core tests (CUDA for sm_90), packs them with
+#   Here:          bench/run-device-benchmark.sh bundle [PROGRAM...]
+#                  builds morea and the core tests (CUDA for sm_90), packs them (and
+#                  PROGRAMs, e.g. an older build's morea renamed, for A/B runs) with
 #                  their libraries and the abdominal CBCT pair into device-carry/.
 #   On the GPU:    bench/run-device-benchmark.sh run OUTDIR [morea benchmark options]
 #                  runs the CPU/CUDA agreement tests, then `morea benchmark` with
@@ -16,6 +17,11 @@
 #                  does both on the GPU machine.
 #   Kernels of several builds: bench/run-device-benchmark.sh early OUTDIR GENERATIONS ROUNDS
 #                  BACKEND PROGRAM... times early generations from scratch, programs in turns.
+#   Where the host's time goes: bench/run-device-benchmark.sh profile OUTDIR SECONDS BACKEND GENERATIONS
+#                  [morea benchmark options] samples the main thread's call stacks over late
+#                  generations (bench/tools/main-thread-profiler.c); here,
+#                  bench/tools/profile-report.py OUTDIR/main-thread.prof --binary build/bin/morea
+#                  names the functions (with the build the bundle was made from).
 #   Refusal bound: bench/run-device-benchmark.sh bound OUTDIR SECONDS BACKEND GENERATIONS [ROUNDS [PROGRAM...]]
 #                  times late generations with --refusal-bound on and off in turns.
 set -euo pipefail
@@ -66,7 +72,9 @@ case "${1:-}" in
     mkdir -p "$stage/abdomen/CB07_masks"
     cp "$DATA"/CB02.mha "$DATA"/CB07.mha "$DATA"/CB02_labels.mha "$DATA"/CB02_labels.txt "$stage/abdomen/"
     cp "$DATA"/CB07_masks/Stomach_duo_CBCT.mha "$DATA"/CB07_masks/Bowel_sm_CBCT.mha "$stage/abdomen/CB07_masks/"
-    scripts/device-bundle.sh --data "$stage/abdomen" build/bin/morea build/test/MOREACoreTests
+    cc -O2 -shared -fPIC -o "$stage/main-thread-profiler.so" bench/tools/main-thread-profiler.c
+    scripts/device-bundle.sh --data "$stage/abdomen" --lib "$stage/main-thread-profiler.so" \
+      build/bin/morea build/test/MOREACoreTests "${@:2}"
     ;;
   run)
     out=${2:?output folder}
@@ -164,6 +172,23 @@ case "${1:-}" in
       done
     done
     ;;
+  profile)
+    # The main thread's call stacks, sampled 1000 times a second over
+    # GENERATIONS late generations from a checkpoint of SECONDS.
+    out=${2:?output folder}
+    seconds=${3:?seconds of the start}
+    backend=${4:?backend}
+    generations=${5:?generations}
+    shift 5
+    mkdir -p "$out" /tmp/ab
+    unpack_bundle
+    [ -f /tmp/ab/profile/checkpoint.bin ] || register /tmp/b/bin/morea /tmp/ab/profile "$seconds" cuda-texture || true
+    MOREA_PROFILE="$out/main-thread.prof" MOREA_PROFILE_HZ=1000 LD_PRELOAD=/tmp/b/lib/main-thread-profiler.so \
+      /tmp/b/bin/morea benchmark "${PROBLEM[@]}" --backends "$backend" --generations "$generations" \
+      --cpu-generations "$generations" --threads 16 --probe 0 --from-checkpoint /tmp/ab/profile/checkpoint.bin \
+      -o "$out/profiled.json" "$@" > "$out/profiled.log" 2>&1
+    summary "$out/profiled.json" "$backend" profiled
+    ;;
   bound)
     # The refusal bound on and off over the same late generations: the
     # bundle's morea registers for SECONDS, then `morea benchmark` of each
@@ -198,7 +223,8 @@ case "${1:-}" in
   *)
     echo "usage: $0 bundle | run OUTDIR [morea benchmark options] | register OUTDIR RUNDIR [SECONDS [BACKEND]]" \
       "| ab OUTDIR SECONDS BACKEND PROGRAM... | late OUTDIR SECONDS BACKEND [GENERATIONS]" \
-      "| early OUTDIR GENERATIONS ROUNDS BACKEND PROGRAM... | bound OUTDIR SECONDS BACKEND GENERATIONS [ROUNDS [PROGRAM...]]" >&2
+      "| early OUTDIR GENERATIONS ROUNDS BACKEND PROGRAM... | profile OUTDIR SECONDS BACKEND GENERATIONS [OPTIONS]" \
+      "| bound OUTDIR SECONDS BACKEND GENERATIONS [ROUNDS [PROGRAM...]]" >&2
     exit 2
     ;;
 esac

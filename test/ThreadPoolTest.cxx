@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
+#include <thread>
 #include <stdexcept>
 #include <vector>
 
@@ -57,4 +59,29 @@ TEST(ThreadPool, AnExceptionReachesTheCallerAndThePoolStaysUsable)
   std::atomic<int> after{ 0 };
   pool.ParallelFor(1000, [&](std::size_t) { after.fetch_add(1); });
   EXPECT_EQ(after.load(), 1000);
+}
+
+// Calls back to back (workers still spinning from the one before, some still
+// inside it) and calls after a pause (workers asleep): each runs its own
+// work, every index once, never the work of the call before.
+TEST(ThreadPool, CallsBackToBackAndAfterAPauseEachRunTheirOwnWork)
+{
+  ThreadPool pool(4);
+  for (int call = 0; call < 20000; ++call)
+  {
+    const std::size_t             count = 2 + static_cast<std::size_t>(call % 37);
+    std::vector<std::atomic<int>> hits(count);
+    std::atomic<int>              foreign{ 0 };
+    pool.ParallelFor(count, [&, call](std::size_t i) {
+      if (i >= count)
+        foreign.fetch_add(1);
+      else
+        hits[i].fetch_add(call + 1);
+    });
+    ASSERT_EQ(foreign.load(), 0) << "call " << call;
+    for (std::size_t i = 0; i < count; ++i)
+      ASSERT_EQ(hits[i].load(), call + 1) << "call " << call << ", index " << i;
+    if (call % 2000 == 0)
+      std::this_thread::sleep_for(std::chrono::milliseconds(5)); // past the workers' spinning
+  }
 }

@@ -251,6 +251,19 @@ private:
   /** How candidate `c` of solution `s` changes its totals, given its values. */
   TetrahedronValues
   CandidateChange(std::size_t s, const Candidate & c, const TetrahedronValues * values) const;
+  /** Solution s's values summed over element e's dependent tetrahedra, kept
+   *  per solution and element: a batch's bounds and changes read each once
+   *  (rather than the tetrahedra's values twice). Brought up to date, where
+   *  an accepted change or a full evaluation made it stale, by
+   *  SetParentState before the candidates of (s, e) need it. */
+  TetrahedronValues
+  ElementSum(std::size_t s, std::size_t e) const;
+  /** The same, summed afresh from the tetrahedra's values. */
+  TetrahedronValues
+  SumOverElement(std::size_t s, std::size_t e) const;
+  /** Marks every element sum of solution s stale. */
+  void
+  InvalidateElementSums(std::size_t s);
   void
   ForcedImprovement(std::size_t solution, int singleObjective, RandomGenerator & random, GenerationRecord & record);
   bool
@@ -277,6 +290,14 @@ private:
   std::vector<std::uint64_t>              m_Ids;
   std::vector<ObjectiveTotals>            m_Totals;
   std::vector<std::vector<TetrahedronValues>> m_TetValues;
+  // See ElementSum; per solution, per element. Written by SetParentState
+  // (const: each candidate of a batch has its own solution and element).
+  mutable std::vector<TetrahedronValues> m_ElementSums;
+  mutable std::vector<std::uint8_t>      m_ElementSumStale;
+  /** Per tetrahedron, the elements it is a dependent of (m_TetElements from
+   *  m_TetElementStart[t] to m_TetElementStart[t + 1]). */
+  std::vector<std::uint32_t> m_TetElementStart;
+  std::vector<std::uint32_t> m_TetElements;
   std::vector<std::size_t>                m_NoImprovement; ///< per solution, generations without an accepted change
   std::uint64_t                           m_NextId{ 0 };
   /** Mixed with a solution's id into PartialCandidate::parentKey: unique to

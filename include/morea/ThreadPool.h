@@ -7,6 +7,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <cstddef>
+#include <cstdint>
 #include <exception>
 #include <functional>
 #include <mutex>
@@ -26,7 +27,8 @@ public:
   operator=(const ThreadPool &) = delete;
 
   /** Calls work(i) for i in [0, count), spread over the threads; returns when
-   *  all are done. The first exception thrown by `work` is rethrown here. */
+   *  all are done. The first exception thrown by `work` is rethrown here.
+   *  One thread at a time calls it, and not from within `work`. */
   void
   ParallelFor(std::size_t count, const std::function<void(std::size_t)> & work);
 
@@ -41,19 +43,26 @@ private:
   WorkerLoop();
   void
   RunShare();
+  /** The next published call after `seen` (even numbers: published), or 0
+   *  when the pool stops; spins a little before sleeping. */
+  std::uint64_t
+  AwaitCall(std::uint64_t seen);
 
-  std::vector<std::thread>                   m_Workers;
-  std::mutex                                 m_Mutex;
-  std::condition_variable                    m_Wake;
-  std::condition_variable                    m_Done;
-  const std::function<void(std::size_t)> *   m_Work{ nullptr };
-  std::size_t                                m_Count{ 0 };
-  std::atomic<std::size_t>                   m_Next{ 0 };
-  std::size_t                                m_Grain{ 1 };
-  std::size_t                                m_Busy{ 0 };
-  std::size_t                                m_Generation{ 0 };
-  bool                                       m_Stop{ false };
-  std::exception_ptr                         m_Error;
+  std::vector<std::thread> m_Workers;
+  // A call is published by an even m_Call; odd while its parameters are
+  // written, which waits until no worker is inside the call before.
+  std::atomic<std::uint64_t>               m_Call{ 0 };
+  std::atomic<std::size_t>                 m_Inside{ 0 }; ///< workers in RunShare
+  std::atomic<std::size_t>                 m_Next{ 0 };
+  const std::function<void(std::size_t)> * m_Work{ nullptr };
+  std::size_t                              m_Count{ 0 };
+  std::size_t                              m_Grain{ 1 };
+  std::atomic<bool>                        m_Stop{ false };
+  // Sleeping workers, woken under the mutex.
+  std::mutex              m_Mutex;
+  std::condition_variable m_Wake;
+  std::atomic<int>        m_Sleeping{ 0 };
+  std::exception_ptr      m_Error; ///< under m_Mutex
 };
 } // namespace morea
 

@@ -286,6 +286,22 @@ MoRvGomea::MoRvGomea(const TetrahedralMesh & base, const MeshTopology & topology
     throw Error("optimiser: the mesh has no FOS elements");
   m_Archive = std::make_unique<ElitistArchive>(options.archiveCapacity);
   m_Pool = std::make_unique<ThreadPool>(options.threads);
+  m_TetElementStart.assign(topology.NumberOfTetrahedra() + 1, 0);
+  for (const FosElement & element : parallel.elements)
+    for (std::uint32_t t : element.dependentTetrahedra)
+    {
+      if (t >= topology.NumberOfTetrahedra())
+        throw Error("optimiser: an element's dependent tetrahedron is not in the mesh");
+      ++m_TetElementStart[t + 1];
+    }
+  std::partial_sum(m_TetElementStart.begin(), m_TetElementStart.end(), m_TetElementStart.begin());
+  m_TetElements.resize(m_TetElementStart.back());
+  {
+    std::vector<std::uint32_t> fill(m_TetElementStart.begin(), m_TetElementStart.end() - 1);
+    for (std::size_t e = 0; e < parallel.elements.size(); ++e)
+      for (std::uint32_t t : parallel.elements[e].dependentTetrahedra)
+        m_TetElements[fill[t]++] = static_cast<std::uint32_t>(e);
+  }
   m_Batch = std::make_unique<CandidateBatch>();
   m_NextBatch = std::make_unique<CandidateBatch>();
   FoldHandling folds;
@@ -334,7 +350,39 @@ MoRvGomea::EvaluatePopulationFully()
     m_Totals[s] = ObjectiveTotals{};
     for (const auto & v : m_TetValues[s])
       m_Totals[s].Add(v);
+    InvalidateElementSums(s);
   }
+}
+
+TetrahedronValues
+MoRvGomea::SumOverElement(std::size_t s, std::size_t e) const
+{
+  // Always in one order, so that a resumed run sums as the uninterrupted
+  // one did.
+  ObjectiveTotals sum;
+  const auto &    stored = m_TetValues[s];
+  for (std::uint32_t t : m_Parallel.elements[e].dependentTetrahedra)
+    sum.Add(stored[t]);
+  return sum.sum;
+}
+
+TetrahedronValues
+MoRvGomea::ElementSum(std::size_t s, std::size_t e) const
+{
+  const std::size_t at = s * m_Parallel.elements.size() + e;
+  return m_ElementSumStale[at] ? SumOverElement(s, e) : m_ElementSums[at];
+}
+
+void
+MoRvGomea::InvalidateElementSums(std::size_t s)
+{
+  const std::size_t elements = m_Parallel.elements.size();
+  if (m_ElementSums.size() != m_Population.size() * elements)
+  {
+    m_ElementSums.assign(m_Population.size() * elements, TetrahedronValues{});
+    m_ElementSumStale.assign(m_Population.size() * elements, 1);
+  }
+  std::fill_n(m_ElementSumStale.begin() + static_cast<std::ptrdiff_t>(s * elements), elements, std::uint8_t{ 1 });
 }
 
 Fitness
@@ -761,6 +809,12 @@ MoRvGomea::SetParentState(CandidateBatch & candidateBatch, std::size_t begin, st
     p.evaluateFolded = std::llround(m_Totals[c.solution].sum.folded) != 0;
     if (p.bound)
       p.bound->skipped = false;
+    const std::size_t at = c.solution * m_Parallel.elements.size() + c.element;
+    if (m_ElementSumStale[at])
+    {
+      m_ElementSums[at] = SumOverElement(c.solution, c.element);
+      m_ElementSumStale[at] = 0;
+    }
   });
 }
 
@@ -774,8 +828,7 @@ MoRvGomea::FillBound(CandidateBatch & candidateBatch, std::size_t i) const
   if (!bound.screened)
     return;
   ObjectiveTotals rest = m_Totals[c.solution];
-  for (std::uint32_t t : m_Parallel.elements[c.element].dependentTetrahedra)
-    rest.Add(m_TetValues[c.solution][t], -1.0);
+  rest.Add(ElementSum(c.solution, c.element), -1.0);
   bound.rest = rest.sum;
   bound.parent = CurrentFitness(c.solution);
 }
@@ -1049,8 +1102,14 @@ MoRvGomea::AcceptCandidates(CandidateBatch & candidateBatch, const std::vector<P
       solution.source[element.points[k]] = source[k];
       solution.target[element.points[k]] = target[k];
     }
+    const std::size_t elements = m_Parallel.elements.size();
     for (std::size_t k = 0; k < element.dependentTetrahedra.size(); ++k)
-      m_TetValues[s][element.dependentTetrahedra[k]] = values[k];
+    {
+      const std::uint32_t t = element.dependentTetrahedra[k];
+      m_TetValues[s][t] = values[k];
+      for (std::uint32_t i = m_TetElementStart[t]; i < m_TetElementStart[t + 1]; ++i)
+        m_ElementSumStale[s * elements + m_TetElements[i]] = 1;
+    }
     m_Totals[s] = totals;
     m_Ids[s] = m_NextId++;
     m_Archive->Insert(*next, solution, m_Ids[s], verdict);
@@ -1063,14 +1122,11 @@ MoRvGomea::AcceptCandidates(CandidateBatch & candidateBatch, const std::vector<P
 TetrahedronValues
 MoRvGomea::CandidateChange(std::size_t s, const Candidate & c, const TetrahedronValues * values) const
 {
-  const FosElement & element = m_Parallel.elements[c.element];
-  const auto &       stored = m_TetValues[s];
-  ObjectiveTotals    change;
-  for (std::size_t k = 0; k < element.dependentTetrahedra.size(); ++k)
-  {
-    change.Add(stored[element.dependentTetrahedra[k]], -1.0);
+  const std::size_t count = m_Parallel.elements[c.element].dependentTetrahedra.size();
+  ObjectiveTotals   change;
+  for (std::size_t k = 0; k < count; ++k)
     change.Add(values[k]);
-  }
+  change.Add(ElementSum(s, c.element), -1.0);
   return change.sum;
 }
 
@@ -1139,6 +1195,7 @@ MoRvGomea::ForcedImprovement(std::size_t s, int singleObjective, RandomGenerator
     m_Totals[s] = ObjectiveTotals{};
     for (const auto & v : m_TetValues[s])
       m_Totals[s].Add(v);
+    InvalidateElementSums(s);
     record.tetrahedronEvaluations += static_cast<double>(m_Topology.NumberOfTetrahedra());
   }
 }

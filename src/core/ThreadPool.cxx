@@ -1,9 +1,33 @@
 #include "morea/ThreadPool.h"
 
 #include <algorithm>
+#include <chrono>
+
+#if defined(__x86_64__) || defined(__i386__)
+#  include <immintrin.h>
+#endif
 
 namespace morea
 {
+namespace
+{
+void
+CpuRelax()
+{
+#if defined(__x86_64__) || defined(__i386__)
+  _mm_pause();
+#else
+  std::this_thread::yield();
+#endif
+}
+
+// How long an idle worker watches for the next call before it sleeps. The
+// optimiser issues calls microseconds to a millisecond apart (a batch's
+// parts, its acceptance rounds); waking sleeping workers through the
+// kernel for each took a large share of those calls' time.
+constexpr auto SpinTime = std::chrono::microseconds(200);
+} // namespace
+
 ThreadPool::ThreadPool(std::size_t threads)
 {
   if (threads == 0)
@@ -16,7 +40,7 @@ ThreadPool::~ThreadPool()
 {
   {
     std::lock_guard<std::mutex> lock(m_Mutex);
-    m_Stop = true;
+    m_Stop.store(true);
   }
   m_Wake.notify_all();
   for (auto & w : m_Workers)
@@ -30,16 +54,8 @@ ThreadPool::~ThreadPool()
 void
 ThreadPool::RunShare()
 {
-  const std::function<void(std::size_t)> * work = nullptr;
-  std::size_t                              count = 0, grain = 1;
-  {
-    std::lock_guard<std::mutex> lock(m_Mutex);
-    work = m_Work;
-    count = m_Count;
-    grain = m_Grain;
-  }
-  if (!work)
-    return;
+  const std::function<void(std::size_t)> * work = m_Work;
+  const std::size_t                        count = m_Count, grain = m_Grain;
   for (;;)
   {
     const std::size_t begin = m_Next.fetch_add(grain);
@@ -62,26 +78,47 @@ ThreadPool::RunShare()
   }
 }
 
+std::uint64_t
+ThreadPool::AwaitCall(std::uint64_t seen)
+{
+  const auto ready = [&](std::uint64_t call) { return call != seen && call % 2 == 0; };
+  const auto until = std::chrono::steady_clock::now() + SpinTime;
+  for (unsigned k = 0;; ++k)
+  {
+    if (m_Stop.load())
+      return 0;
+    const std::uint64_t call = m_Call.load();
+    if (ready(call))
+      return call;
+    CpuRelax();
+    if (k % 64 == 63 && std::chrono::steady_clock::now() > until)
+      break;
+  }
+  std::unique_lock<std::mutex> lock(m_Mutex);
+  m_Sleeping.fetch_add(1);
+  // A call published after this count was read by ParallelFor is seen here
+  // (both are sequentially consistent); one published before, it wakes.
+  m_Wake.wait(lock, [&] { return m_Stop.load() || ready(m_Call.load()); });
+  m_Sleeping.fetch_sub(1);
+  return m_Stop.load() ? 0 : m_Call.load();
+}
+
 void
 ThreadPool::WorkerLoop()
 {
-  std::size_t seen = 0;
+  std::uint64_t seen = 0;
   for (;;)
   {
-    {
-      std::unique_lock<std::mutex> lock(m_Mutex);
-      m_Wake.wait(lock, [&] { return m_Stop || m_Generation != seen; });
-      if (m_Stop)
-        return;
-      seen = m_Generation;
-      ++m_Busy;
-    }
-    RunShare();
-    {
-      std::lock_guard<std::mutex> lock(m_Mutex);
-      --m_Busy;
-    }
-    m_Done.notify_all();
+    const std::uint64_t call = AwaitCall(seen);
+    if (call == 0)
+      return;
+    m_Inside.fetch_add(1);
+    // The parameters are those of `call` only while it is still published:
+    // its successor waits for m_Inside to drop before writing them.
+    if (m_Call.load() == call)
+      RunShare();
+    m_Inside.fetch_sub(1);
+    seen = call;
   }
 }
 
@@ -96,22 +133,28 @@ ThreadPool::ParallelFor(std::size_t count, const std::function<void(std::size_t)
       work(i);
     return;
   }
+  // Unpublish the last call and wait for workers still inside it (they
+  // find no work left) before its parameters change.
+  m_Call.fetch_add(1);
+  while (m_Inside.load() != 0)
+    CpuRelax();
+  m_Work = &work;
+  m_Count = count;
+  m_Grain = std::max<std::size_t>(1, count / (8 * (m_Workers.size() + 1)));
+  m_Next.store(0);
+  m_Call.fetch_add(1);
+  if (m_Sleeping.load() > 0)
   {
     std::lock_guard<std::mutex> lock(m_Mutex);
-    m_Work = &work;
-    m_Count = count;
-    m_Grain = std::max<std::size_t>(1, count / (8 * (m_Workers.size() + 1)));
-    m_Next.store(0);
-    m_Error = nullptr;
-    ++m_Generation;
+    m_Wake.notify_all();
   }
-  m_Wake.notify_all();
   RunShare();
+  // All handed out; wait for the chunks still running.
+  while (m_Inside.load() != 0)
+    CpuRelax();
   std::exception_ptr error;
   {
-    std::unique_lock<std::mutex> lock(m_Mutex);
-    m_Done.wait(lock, [&] { return m_Busy == 0 && m_Next >= m_Count; });
-    m_Work = nullptr;
+    std::lock_guard<std::mutex> lock(m_Mutex);
     error = m_Error;
     m_Error = nullptr;
   }
