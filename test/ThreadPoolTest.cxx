@@ -85,3 +85,28 @@ TEST(ThreadPool, CallsBackToBackAndAfterAPauseEachRunTheirOwnWork)
       std::this_thread::sleep_for(std::chrono::milliseconds(5)); // past the workers' spinning
   }
 }
+
+// One pool per thread count while someone holds it; a call from within a
+// call (or from another thread during one) runs on its caller alone and
+// still covers every index.
+TEST(ThreadPool, SharedPoolsAndCallsWithinCalls)
+{
+  auto a = ThreadPool::Shared(3);
+  auto b = ThreadPool::Shared(3);
+  auto c = ThreadPool::Shared(2);
+  EXPECT_EQ(a.get(), b.get());
+  EXPECT_NE(a.get(), c.get());
+  EXPECT_EQ(a->NumberOfThreads(), 3u);
+  std::vector<std::atomic<int>> hits(40 * 50);
+  a->ParallelFor(40, [&](std::size_t i) {
+    b->ParallelFor(50, [&](std::size_t k) { hits[i * 50 + k].fetch_add(1); });
+  });
+  std::size_t wrong = 0;
+  for (const auto & h : hits)
+    wrong += h.load() != 1;
+  EXPECT_EQ(wrong, 0u);
+  // Still usable in parallel afterwards.
+  std::atomic<int> after{ 0 };
+  a->ParallelFor(1000, [&](std::size_t) { after.fetch_add(1); });
+  EXPECT_EQ(after.load(), 1000);
+}

@@ -281,7 +281,7 @@ private:
   const FoldConstraint &    m_Constraint;
   EvaluationBackend &       m_Backend;
   GomeaOptions              m_Options;
-  std::unique_ptr<ThreadPool> m_Pool; ///< candidate sampling and fold checks
+  std::shared_ptr<ThreadPool> m_Pool; ///< candidate sampling and acceptance (shared with the backend)
   std::unique_ptr<CandidateBatch> m_Batch; ///< reused by every batch
   std::unique_ptr<CandidateBatch> m_NextBatch; ///< sampled while m_Batch is evaluated
 

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <exception>
 #include <functional>
+#include <memory>
 #include <mutex>
 #include <thread>
 #include <vector>
@@ -26,9 +27,17 @@ public:
   ThreadPool &
   operator=(const ThreadPool &) = delete;
 
+  /** The pool of `threads` threads (0: one per hardware thread) shared by
+   *  all who ask for that many while one of them holds it: the optimiser and
+   *  its backend take turns on one set of workers rather than keeping two
+   *  sets that compete for the cores. */
+  static std::shared_ptr<ThreadPool>
+  Shared(std::size_t threads = 0);
+
   /** Calls work(i) for i in [0, count), spread over the threads; returns when
    *  all are done. The first exception thrown by `work` is rethrown here.
-   *  One thread at a time calls it, and not from within `work`. */
+   *  A call while another is under way (from another thread, or from within
+   *  `work`) runs on its calling thread alone. */
   void
   ParallelFor(std::size_t count, const std::function<void(std::size_t)> & work);
 
@@ -49,6 +58,7 @@ private:
   AwaitCall(std::uint64_t seen);
 
   std::vector<std::thread> m_Workers;
+  std::atomic<bool>        m_InUse{ false }; ///< a ParallelFor is under way
   // A call is published by an even m_Call; odd while its parameters are
   // written, which waits until no worker is inside the call before.
   std::atomic<std::uint64_t>               m_Call{ 0 };

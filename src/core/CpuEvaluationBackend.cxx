@@ -89,7 +89,7 @@ class CpuEvaluationBackend final : public EvaluationBackend
 public:
   CpuEvaluationBackend(const TetrahedronEvaluator & evaluator, std::size_t threads)
     : m_Evaluator(evaluator)
-    , m_Pool(threads)
+    , m_Pool(ThreadPool::Shared(threads))
   {}
 
   std::string
@@ -117,7 +117,7 @@ public:
     const auto            start = std::chrono::steady_clock::now();
     constexpr std::size_t chunk = 64;
     const std::size_t     chunksPerSolution = (tets + chunk - 1) / chunk;
-    m_Pool.ParallelFor(solutions.size() * chunksPerSolution, [&](std::size_t job) {
+    m_Pool->ParallelFor(solutions.size() * chunksPerSolution, [&](std::size_t job) {
       const std::size_t s = job / chunksPerSolution;
       const std::size_t begin = (job % chunksPerSolution) * chunk;
       const std::size_t end = std::min(tets, begin + chunk);
@@ -142,7 +142,7 @@ public:
     std::vector<std::uint8_t> skip(candidates.size(), 0);
     if (m_FoldHandling.constraint)
     {
-      m_Pool.ParallelFor(candidates.size(), [&](std::size_t i) {
+      m_Pool->ParallelFor(candidates.size(), [&](std::size_t i) {
         const PartialCandidate & c = candidates[i];
         if (!c.folds)
           return;
@@ -154,7 +154,7 @@ public:
     // The corners' values first; a candidate whose bound is refused then
     // goes without samples.
     const RefusalScreen * screen = m_HasRefusalScreen ? &m_RefusalScreen : nullptr;
-    m_Pool.ParallelFor(candidates.size(), [&](std::size_t i) {
+    m_Pool->ParallelFor(candidates.size(), [&](std::size_t i) {
       const PartialCandidate & c = candidates[i];
       if (c.bound)
         c.bound->skipped = false;
@@ -213,7 +213,7 @@ public:
     for (std::size_t i : which)
       if (i >= candidates.size() || !candidates[i].bound || !candidates[i].bound->skipped)
         throw Error("evaluation backend: only candidates the bound skipped can be sampled later");
-    m_Pool.ParallelFor(which.size(), [&](std::size_t w) { AddSampleSums(candidates[which[w]]); });
+    m_Pool->ParallelFor(which.size(), [&](std::size_t w) { AddSampleSums(candidates[which[w]]); });
     for (std::size_t i : which)
     {
       const PartialCandidate & c = candidates[i];
@@ -255,7 +255,7 @@ private:
   }
 
   const TetrahedronEvaluator & m_Evaluator;
-  ThreadPool                   m_Pool;
+  std::shared_ptr<ThreadPool> m_Pool;
 };
 } // namespace
 

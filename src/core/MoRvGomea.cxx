@@ -285,7 +285,7 @@ MoRvGomea::MoRvGomea(const TetrahedralMesh & base, const MeshTopology & topology
   if (parallel.elements.empty())
     throw Error("optimiser: the mesh has no FOS elements");
   m_Archive = std::make_unique<ElitistArchive>(options.archiveCapacity);
-  m_Pool = std::make_unique<ThreadPool>(options.threads);
+  m_Pool = ThreadPool::Shared(options.threads);
   m_TetElementStart.assign(topology.NumberOfTetrahedra() + 1, 0);
   for (const FosElement & element : parallel.elements)
     for (std::uint32_t t : element.dependentTetrahedra)

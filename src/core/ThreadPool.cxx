@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <map>
 
 #if defined(__x86_64__) || defined(__i386__)
 #  include <immintrin.h>
@@ -27,6 +28,23 @@ CpuRelax()
 // kernel for each took a large share of those calls' time.
 constexpr auto SpinTime = std::chrono::microseconds(200);
 } // namespace
+
+std::shared_ptr<ThreadPool>
+ThreadPool::Shared(std::size_t threads)
+{
+  if (threads == 0)
+    threads = std::max<std::size_t>(1, std::thread::hardware_concurrency());
+  static std::mutex                                   mutex;
+  static std::map<std::size_t, std::weak_ptr<ThreadPool>> pools;
+  std::lock_guard<std::mutex>                         lock(mutex);
+  std::shared_ptr<ThreadPool>                         pool = pools[threads].lock();
+  if (!pool)
+  {
+    pool = std::make_shared<ThreadPool>(threads);
+    pools[threads] = pool;
+  }
+  return pool;
+}
 
 ThreadPool::ThreadPool(std::size_t threads)
 {
@@ -127,12 +145,18 @@ ThreadPool::ParallelFor(std::size_t count, const std::function<void(std::size_t)
 {
   if (count == 0)
     return;
-  if (m_Workers.empty() || count == 1)
+  bool idle = false;
+  if (m_Workers.empty() || count == 1 || !m_InUse.compare_exchange_strong(idle, true))
   {
     for (std::size_t i = 0; i < count; ++i)
       work(i);
     return;
   }
+  struct Release
+  {
+    std::atomic<bool> & inUse;
+    ~Release() { inUse.store(false); }
+  } release{ m_InUse };
   // Unpublish the last call and wait for workers still inside it (they
   // find no work left) before its parameters change.
   m_Call.fetch_add(1);

@@ -8,6 +8,7 @@
 
 #include <cuda_runtime.h>
 
+#include <algorithm>
 #include <cstddef>
 #include <string>
 
@@ -56,7 +57,7 @@ struct PinnedAllocation
   }
 };
 
-/** `count` elements of T; grows on demand (losing the contents), never shrinks. */
+/** At least `count` elements of T; grows on demand (losing the contents), never shrinks. */
 template <typename T, typename Allocation>
 class GrowingArray
 {
@@ -73,6 +74,11 @@ public:
   {
     if (count <= m_Capacity)
       return;
+    // Half as much again once it has grown: freeing waits for the device
+    // (a buffer sized by the archive or by a batch's parents grew by a few
+    // elements at a time, and each wait cost a paper-scale generation ms).
+    if (m_Capacity > 0)
+      count = std::max(count, m_Capacity + m_Capacity / 2);
     Release();
     const std::size_t bytes = count * sizeof(T);
     void *            p = nullptr;
