@@ -38,12 +38,12 @@ PROBLEM=(--fixed "$D/CB02.mha" --moving "$D/CB07.mha"
   --moving-structure Bowel_sm_CBCT="$D/CB07_masks/Bowel_sm_CBCT.mha"
   --parameters bench/configurations/abdomen_paper.toml)
 
-# register PROGRAM RUNDIR SECONDS BACKEND: `morea register` of the paper's
+# register PROGRAM RUNDIR SECONDS BACKEND [OPTIONS]: `morea register` of the paper's
 # configuration on the bundled pair, resuming RUNDIR's checkpoint, stopped
 # (SIGKILL) after SECONDS; the log is appended to RUNDIR/register.log.
 register() {
   mkdir -p "$2"
-  timeout --signal=KILL "$3" "$1" register "${PROBLEM[@]}" --backend "$4" \
+  timeout --signal=KILL "$3" "$1" register "${PROBLEM[@]}" --backend "$4" "${@:5}" \
     --checkpoint-every 10 --resume -o "$2" >> "$2/register.log" 2>&1
 }
 # The bundle unpacked into /tmp/b (once per machine) and its libraries found.
@@ -96,10 +96,11 @@ case "${1:-}" in
     run=${3:?run folder}
     seconds=${4:-540}
     backend=${5:-cuda}
+    shift $(( $# < 5 ? $# : 5 ))
     mkdir -p "$out" "$run"
     unpack_bundle
     status=0
-    register /tmp/b/bin/morea "$run" "$seconds" "$backend" || status=$?
+    register /tmp/b/bin/morea "$run" "$seconds" "$backend" "$@" || status=$?
     tail -c 4000 "$run/register.log" | tee "$out/register-tail.log"
     cp "$run"/generations.csv "$run"/summary.json "$run"/front.csv "$out/" 2>/dev/null || true
     echo "register exit status $status (137: stopped after $seconds s; call again to resume)"
@@ -221,7 +222,7 @@ case "${1:-}" in
     done
     ;;
   *)
-    echo "usage: $0 bundle | run OUTDIR [morea benchmark options] | register OUTDIR RUNDIR [SECONDS [BACKEND]]" \
+    echo "usage: $0 bundle [PROGRAM...] | run OUTDIR [morea benchmark options] | register OUTDIR RUNDIR [SECONDS [BACKEND [OPTIONS]]]" \
       "| ab OUTDIR SECONDS BACKEND PROGRAM... | late OUTDIR SECONDS BACKEND [GENERATIONS]" \
       "| early OUTDIR GENERATIONS ROUNDS BACKEND PROGRAM... | profile OUTDIR SECONDS BACKEND GENERATIONS [OPTIONS]" \
       "| bound OUTDIR SECONDS BACKEND GENERATIONS [ROUNDS [PROGRAM...]]" >&2
