@@ -119,10 +119,21 @@ ThreadPool::AwaitCall(std::uint64_t seen)
   std::unique_lock<std::mutex> lock(m_Mutex);
   m_Sleeping.fetch_add(1);
   // A call published after this count was read by ParallelFor is seen here
-  // (both are sequentially consistent); one published before, it wakes.
-  m_Wake.wait(lock, [&] { return m_Stop.load() || ready(m_Call.load()); });
+  // (both are sequentially consistent); one published before, it wakes. The
+  // value returned is the published one that was seen: m_Call may be odd
+  // again by now, while the next call's parameters are written.
+  std::uint64_t found = 0;
+  m_Wake.wait(lock, [&] {
+    if (m_Stop.load())
+      return true;
+    const std::uint64_t call = m_Call.load();
+    if (!ready(call))
+      return false;
+    found = call;
+    return true;
+  });
   m_Sleeping.fetch_sub(1);
-  return m_Stop.load() ? 0 : m_Call.load();
+  return m_Stop.load() ? 0 : found;
 }
 
 void
