@@ -1469,14 +1469,14 @@ private:
   UnpackRange(const BatchFlight & f, const std::uint64_t * first, std::size_t begin, std::size_t end, Output out,
               const std::uint32_t * spared = nullptr)
   {
-    // Per group: its samples, or minus its items when left alone.
-    std::vector<double> samples(end - begin, 0.0);
+    std::vector<double>       samples(end - begin, 0.0);
+    std::vector<std::uint8_t> leftAlone(end - begin, 0);
     m_Pool->ParallelFor(end - begin, [&](std::size_t g) {
       const std::size_t   i = begin + g;
       TetrahedronValues * o = out(i);
       if (o == nullptr)
       {
-        samples[g] = -static_cast<double>(first[i + 1] - first[i]);
+        leftAlone[g] = 1;
         return;
       }
       for (std::size_t item = first[i]; item < first[i + 1]; ++item)
@@ -1486,20 +1486,20 @@ private:
         ++o;
       }
     });
-    std::uint64_t leftAlone = 0;
+    std::uint64_t itemsLeftAlone = 0;
     for (std::size_t g = 0; g < samples.size(); ++g)
     {
-      const double counted = std::max(0.0, samples[g]);
-      leftAlone += static_cast<std::uint64_t>(counted - samples[g]);
+      if (leftAlone[g])
+        itemsLeftAlone += first[begin + g + 1] - first[begin + g];
       if (spared && spared[begin + g])
       {
         ++m_Statistics.boundSkipped;
-        m_Statistics.boundSkippedSamples += counted;
+        m_Statistics.boundSkippedSamples += samples[g];
       }
       else
-        m_Statistics.samples += counted;
+        m_Statistics.samples += samples[g];
     }
-    return leftAlone;
+    return itemsLeftAlone;
   }
 
   const TetrahedronEvaluator &  m_Evaluator;
