@@ -118,9 +118,16 @@ InsertRandomly(ElitistArchive & archive, std::size_t count, std::uint64_t seed, 
     const Fitness f = RandomCandidate(random, static_cast<double>(id) / static_cast<double>(count), shift);
     candidates.push_back(f);
     const std::vector<morea::ArchiveEntry> before = archive.Entries();
+    const std::vector<std::uint64_t>       witnessesBefore = archive.Witnesses();
     const bool                            accepted = archive.Accepts(f);
     const bool                            inserted = archive.Insert(f, PayloadOf(id), id);
     ASSERT_LE(archive.Size(), archive.Capacity());
+    // Holds() tells exactly the entries here by their insertion numbers.
+    const std::vector<std::uint64_t> witnesses = archive.Witnesses();
+    for (std::uint64_t w : witnesses)
+      ASSERT_TRUE(archive.Holds(w)) << id;
+    for (std::uint64_t w : witnessesBefore)
+      ASSERT_EQ(archive.Holds(w), std::find(witnesses.begin(), witnesses.end(), w) != witnesses.end()) << id;
     const auto & entries = archive.Entries();
     const auto   find = [&](std::uint64_t wanted) {
       return std::find_if(entries.begin(), entries.end(), [&](const auto & e) { return e.id == wanted; });
@@ -405,7 +412,7 @@ TEST(ElitistArchive, JudgeAgreesWithAFullScan)
     const ElitistArchive archive = FilledArchive(capacity, 1500, 5 + capacity);
     ASSERT_EQ(archive.IsDiscretised(), capacity == 60);
     morea::RandomGenerator random(11);
-    std::size_t            kinds[3] = {};
+    std::size_t            kinds[4] = {};
     morea::ArchiveVerdict  previous;
     for (int i = 0; i < 4000; ++i)
     {
@@ -415,8 +422,21 @@ TEST(ElitistArchive, JudgeAgreesWithAFullScan)
       ++kinds[static_cast<int>(verdict.kind)];
       EXPECT_EQ(verdict.kind == morea::ArchiveVerdict::Kind::Accepted, accepts) << i;
       EXPECT_EQ(verdict.kind == morea::ArchiveVerdict::Kind::Rejected, RejectedByDominance(archive, f)) << i;
-      if (verdict.kind == morea::ArchiveVerdict::Kind::Unknown)
+      EXPECT_NE(verdict.kind, morea::ArchiveVerdict::Kind::Unknown) << i;
+      if (verdict.kind == morea::ArchiveVerdict::Kind::Crowded)
+      {
+        // Refused by the cell of an entry here, which it does not dominate.
         EXPECT_TRUE(archive.IsDiscretised()) << i;
+        ASSERT_TRUE(archive.Holds(verdict.witness)) << i;
+        const auto witnesses = archive.Witnesses();
+        const auto & holder = archive.Entries()[static_cast<std::size_t>(
+          std::find(witnesses.begin(), witnesses.end(), verdict.witness) - witnesses.begin())];
+        EXPECT_EQ(CellOf(holder.fitness.objectives, archive.CellWidths()), CellOf(f.objectives, archive.CellWidths()))
+          << i;
+        EXPECT_FALSE(morea::Dominates(f.objectives, holder.fitness.objectives)) << i;
+        morea::ArchiveVerdict copy = verdict;
+        EXPECT_FALSE(archive.Accepts(f, copy)) << i;
+      }
       EXPECT_EQ(verdict.revision, archive.ThinningRevision());
       // A witness is only a hint: any one, or none, gives the same verdict.
       EXPECT_EQ(archive.Judge(f, previous.witness).kind, verdict.kind) << i;
@@ -429,10 +449,10 @@ TEST(ElitistArchive, JudgeAgreesWithAFullScan)
       EXPECT_EQ(archive.Accepts(f, hinted), accepts) << i;
       previous = verdict;
     }
-    // All kinds came up (Unknown only with a grid).
+    // All kinds came up (Crowded only with a grid).
     EXPECT_GT(kinds[static_cast<int>(morea::ArchiveVerdict::Kind::Rejected)], 100u) << capacity;
     EXPECT_GT(kinds[static_cast<int>(morea::ArchiveVerdict::Kind::Accepted)], 100u) << capacity;
-    EXPECT_EQ(kinds[static_cast<int>(morea::ArchiveVerdict::Kind::Unknown)] > 0, archive.IsDiscretised()) << capacity;
+    EXPECT_EQ(kinds[static_cast<int>(morea::ArchiveVerdict::Kind::Crowded)] > 0, archive.IsDiscretised()) << capacity;
   }
 }
 

@@ -43,6 +43,9 @@ def main():
     parser.add_argument("--callers-of", help="the callers of the samples whose innermost frame contains this")
     parser.add_argument("--skip", type=float, default=0.0,
                         help="leave out this fraction of the (--under) samples, the first ones (warming up)")
+    parser.add_argument("--lines", help="source lines of the outermost frame in a function whose name holds this")
+    parser.add_argument("--depth", type=int, default=0,
+                        help="with --lines: the line this many inlined calls inside that frame's own")
     parser.add_argument("--top", type=int, default=40)
     args = parser.parse_args()
 
@@ -62,15 +65,16 @@ def main():
     binaries = {os.path.basename(b): load_symbols(b) for b in args.binary}
     cache = {}
 
-    def name(address):
+    def locate(address):
+        """(binary's file name, its virtual address, function name) of an address."""
         if address in cache:
             return cache[address]
         i = bisect.bisect_right(starts, address) - 1
-        result = "?"
+        result = (None, None, "?")
         if i >= 0 and address < maps[i][1]:
             lo, _, offset, path = maps[i]
             base = os.path.basename(path)
-            result = base
+            result = (base, None, base)
             if base in binaries:
                 syms, names, segments = binaries[base]
                 fileoffset = address - lo + offset
@@ -79,20 +83,27 @@ def main():
                         v = fileoffset - seg_offset + vaddr
                         k = bisect.bisect_right(syms, v) - 1
                         if k >= 0:
-                            result = names[k]
+                            result = (base, v, names[k])
                         break
         cache[address] = result
         return result
 
-    samples = []
+    def name(address):
+        return locate(address)[2]
+
+    samples, addresses = [], []
     for stack in stacks:
         # Frames 0 and 1 are the signal handler and the kernel's return
         # trampoline; frame 2 the interrupted instruction; the rest return
         # addresses (one byte back lands in the call).
-        frames = [name(a) for a in stack[2:3]] + [name(a - 1) for a in stack[3:]]
-        samples.append(frames)
+        frame_addresses = stack[2:3] + [a - 1 for a in stack[3:]]
+        samples.append([name(a) for a in frame_addresses])
+        addresses.append(frame_addresses)
     if args.under:
-        samples = [s for s in samples if any(args.under in f for f in s)]
+        kept = [i for i, s in enumerate(samples) if any(args.under in f for f in s)]
+        samples = [samples[i] for i in kept]
+        addresses = [addresses[i] for i in kept]
+    addresses = addresses[int(args.skip * len(addresses)):]
     samples = samples[int(args.skip * len(samples)):]
     total = len(samples)
     print(f"{header}; {total} samples shown")
@@ -120,6 +131,40 @@ def main():
                 rest = [f for f in s if args.callers_of not in f]
                 callers[rest[0] if rest else "?"] += 1
         show(f"first caller outside '{args.callers_of}' of the innermost frames in it", callers)
+    if args.lines:
+        # Source lines (the binary needs line tables: the bundle builds with
+        # -g1) of the outermost frame in a function whose name holds TEXT:
+        # where its own time and its calls' time went, line by line.
+        wanted = collections.defaultdict(list)
+        for s, a in zip(samples, addresses):
+            hits = [i for i, f in enumerate(s) if args.lines in f]
+            if hits:
+                base, v, _ = locate(a[max(hits)])
+                if v is not None:
+                    wanted[base].append(v)
+        outer, inner = collections.Counter(), collections.Counter()
+        for base, vs in wanted.items():
+            path = next(b for b in args.binary if os.path.basename(b) == base)
+            unique = sorted(set(vs))
+            # addr2line -i prints one (function, file:line) pair per inline
+            # level, innermost first; an address 0 after each one ends its
+            # chain with a pair of "??".
+            query = "".join(f"{hex(v)}\n0x0\n" for v in unique)
+            out = subprocess.run(["addr2line", "-i", "-C", "-f", "-e", path], input=query,
+                                 capture_output=True, text=True).stdout.splitlines()
+            chains, chain, j = {}, [], 0
+            for k in range(0, len(out) - 1, 2):
+                if out[k] == "??" and out[k + 1].startswith("??"):
+                    chains[unique[j]] = chain
+                    chain, j = [], j + 1
+                else:
+                    chain.append(os.path.basename(out[k + 1].split(" (")[0]))
+            for v in vs:
+                chain = chains.get(v) or ["?"]
+                outer[chain[max(0, len(chain) - 1 - args.depth)]] += 1
+                inner[chain[0]] += 1
+        show(f"lines of the outermost '{args.lines}' frame, {args.depth} inlined calls in", outer)
+        show(f"innermost inlined lines there", inner)
 
 
 if __name__ == "__main__":

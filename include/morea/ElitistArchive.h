@@ -27,9 +27,14 @@ struct ArchiveVerdict
 {
   enum class Kind : std::uint8_t
   {
-    Unknown,  ///< nothing known (or refused only for sharing a grid cell)
+    Unknown,  ///< nothing known
     Rejected, ///< infeasible, non-finite, or an entry dominates or equals it
-    Accepted  ///< Accepts() was true
+    Accepted, ///< Accepts() was true
+    /** Refused only for sharing the grid cell of the witness, which it does
+     *  not dominate: that holds while the witness stays and the grid is
+     *  unchanged, and no longer (the witness can leave for a newcomer that
+     *  does not dominate `f`). */
+    Crowded
   };
   Kind          kind{ Kind::Unknown };
   std::uint64_t revision{ 0 };   ///< the archive's ThinningRevision() then
@@ -53,7 +58,7 @@ public:
 
   /** A verdict on `f` against the archive as it is now: Rejected exactly when
    *  `f` is infeasible or non-finite or an entry equals or dominates it,
-   *  Accepted exactly when Accepts(f), else Unknown. Tries the entry `witness`
+   *  Accepted exactly when Accepts(f), else Crowded. Tries the entry `witness`
    *  (an earlier verdict's) first, a hint that does not change the verdict.
    *  Safe to call from several threads at once (while nothing changes the
    *  archive). */
@@ -64,8 +69,9 @@ public:
    *  Judge() or by this call), which it brings up to date. While the archive has
    *  since only gained entries and lost dominated ones (ThinningRevision()
    *  unchanged), a rejection still holds (a dominated entry leaves only for a
-   *  newcomer that dominates it, and so `f` too) and an acceptance needs a look
-   *  at the newer entries only; otherwise this scans as Accepts(f) does.
+   *  newcomer that dominates it, and so `f` too), a crowding holds while its
+   *  witness is here, and an acceptance needs a look at the newer entries
+   *  only; otherwise this scans as Accepts(f) does.
    *  Not for concurrent calls. */
   bool
   Accepts(const Fitness & f, ArchiveVerdict & verdict) const;
@@ -127,6 +133,13 @@ public:
   {
     return m_CellWidths;
   }
+  /** Whether the entry with insertion number `serial` is still here. */
+  bool
+  Holds(std::uint64_t serial) const
+  {
+    return serial < m_Present.size() && m_Present[serial];
+  }
+
   /** Restores a saved archive as it was (no checks beyond the capacity). */
   void
   Restore(std::vector<ArchiveEntry> entries, bool discretised, const ObjectiveVector & cellWidths);
@@ -140,6 +153,8 @@ private:
     /** Entries inserted before it: ascending in entry order, so the entries
      *  newer than a verdict are a suffix. */
     std::uint64_t serial;
+    /** Its grid cell (when discretised), kept so a scan need not divide. */
+    ObjectiveVector cell;
   };
   class EntryTest;
   struct Refuser;
@@ -157,13 +172,25 @@ private:
   /** Inserts `f`, known to be accepted now. */
   bool
   InsertAccepted(const Fitness & f, const DualMesh & solution, std::uint64_t id);
-  /** Removes the entries for which keep[i] is false, in order. */
+  /** Removes the entries for which keep[i] is false, in order; keep[i] is
+   *  true for all i before `first`. Their meshes' buffers are kept for reuse. */
   void
-  Compact(const std::vector<bool> & keep);
+  Compact(const std::vector<bool> & keep, std::size_t first = 0);
+  /** Appends an entry and its key (the key's cell for the current grid). */
+  void
+  Append(const Fitness & f, const DualMesh & solution, std::uint64_t id);
+  /** Sets every key's cell for the current grid. */
+  void
+  RefreshCells();
 
   std::size_t               m_Capacity;
   std::vector<ArchiveEntry> m_Entries;
   std::vector<Key>          m_Keys; ///< per entry, in entry order
+  std::vector<bool>         m_Present; ///< per insertion number: whether that entry is here
+  /** Meshes of removed entries, whose buffers a newcomer's copy reuses: most
+   *  newcomers soon leave for a better one, and a copy into buffers of the
+   *  right size needs no allocation. */
+  std::vector<DualMesh> m_SpareMeshes;
   std::uint64_t             m_Insertions{ 0 };
   std::uint64_t             m_Revision{ 0 };
   bool                      m_Discretised{ false };

@@ -139,15 +139,15 @@ public:
   EntryTest(const ObjectiveVector & f, bool discretised, const ObjectiveVector & widths)
     : m_F(f)
     , m_Discretised(discretised)
-    , m_Widths(widths)
     , m_Cell(discretised ? CellOf(f, widths) : Cell{})
   {}
   Refusal
-  operator()(const ObjectiveVector & y) const
+  operator()(const Key & y) const
   {
-    if (EqualsOrDominates(y, m_F))
+    if (EqualsOrDominates(y.objectives, m_F))
       return Refusal::Dominance;
-    if (m_Discretised && CellOf(y, m_Widths) == m_Cell && !Dominates(m_F, y))
+    // y.cell is CellOf(y.objectives, m_Widths): the grid is the archive's.
+    if (m_Discretised && y.cell == m_Cell && !Dominates(m_F, y.objectives))
       return Refusal::Cell;
     return Refusal::None;
   }
@@ -155,7 +155,6 @@ public:
 private:
   ObjectiveVector m_F;
   bool            m_Discretised;
-  ObjectiveVector m_Widths;
   Cell            m_Cell;
 };
 
@@ -195,19 +194,28 @@ ElitistArchive::Judge(const Fitness & f, std::uint64_t witness) const
   ArchiveVerdict verdict{ ArchiveVerdict::Kind::Rejected, m_Revision, m_Insertions, witness };
   if (!f.feasible || !AllFinite(f.objectives))
     return verdict;
-  // Dominance first: the refusal that lasts, and cheaper to test than the grid.
+  // Dominance first: the refusal that lasts.
   const std::size_t hint = IndexOf(witness);
   if (hint < m_Keys.size() && EqualsOrDominates(m_Keys[hint].objectives, f.objectives))
     return verdict;
+  // One pass for both refusals: any entry that equals or dominates `f`
+  // rejects it; else the hint, or the first entry, that crowds it does.
+  const EntryTest   refuses(f.objectives, m_Discretised, m_CellWidths);
+  std::size_t       crowding = m_Keys.size();
   for (std::size_t i = 0; i < m_Keys.size(); ++i)
-    if (EqualsOrDominates(m_Keys[i].objectives, f.objectives))
+  {
+    const Refusal refusal = refuses(m_Keys[i]);
+    if (refusal == Refusal::Dominance)
     {
       verdict.witness = m_Keys[i].serial;
       return verdict;
     }
-  // Then the grid, which now can only refuse for a shared cell.
-  Settle(verdict, m_Discretised ? FindRefuser(EntryTest(f.objectives, true, m_CellWidths), hint, m_Keys.size())
-                                : Refuser{ m_Keys.size(), Refusal::None });
+    if (refusal == Refusal::Cell && crowding == m_Keys.size())
+      crowding = i;
+  }
+  if (hint < m_Keys.size() && crowding < m_Keys.size() && refuses(m_Keys[hint]) == Refusal::Cell)
+    crowding = hint;
+  Settle(verdict, Refuser{ crowding, crowding < m_Keys.size() ? Refusal::Cell : Refusal::None });
   return verdict;
 }
 
@@ -216,6 +224,9 @@ ElitistArchive::Accepts(const Fitness & f, ArchiveVerdict & verdict) const
 {
   using Kind = ArchiveVerdict::Kind;
   if (verdict.revision == m_Revision && verdict.kind == Kind::Rejected)
+    return false;
+  // Same grid, same cell; the witness still refuses while it is here.
+  if (verdict.revision == m_Revision && verdict.kind == Kind::Crowded && Holds(verdict.witness))
     return false;
   if (verdict.revision == m_Revision && verdict.kind == Kind::Accepted)
   {
@@ -226,7 +237,7 @@ ElitistArchive::Accepts(const Fitness & f, ArchiveVerdict & verdict) const
                                         [](const Key & k, std::uint64_t serial) { return k.serial < serial; });
     Refuser         refuser{ m_Keys.size(), Refusal::None };
     for (auto i = static_cast<std::size_t>(newer - m_Keys.begin()); i < m_Keys.size(); ++i)
-      if (const Refusal refusal = refuses(m_Keys[i].objectives); refusal != Refusal::None)
+      if (const Refusal refusal = refuses(m_Keys[i]); refusal != Refusal::None)
       {
         refuser = Refuser{ i, refusal };
         break;
@@ -257,10 +268,10 @@ ElitistArchive::FindRefuser(const EntryTest & refuses, std::size_t first, std::s
 {
   for (std::size_t hint : { first, second })
     if (hint < m_Keys.size())
-      if (const Refusal refusal = refuses(m_Keys[hint].objectives); refusal != Refusal::None)
+      if (const Refusal refusal = refuses(m_Keys[hint]); refusal != Refusal::None)
         return Refuser{ hint, refusal };
   for (std::size_t i = 0; i < m_Keys.size(); ++i)
-    if (const Refusal refusal = refuses(m_Keys[i].objectives); refusal != Refusal::None)
+    if (const Refusal refusal = refuses(m_Keys[i]); refusal != Refusal::None)
       return Refuser{ i, refusal };
   return Refuser{ m_Keys.size(), Refusal::None };
 }
@@ -276,8 +287,8 @@ ElitistArchive::Settle(ArchiveVerdict & verdict, const Refuser & refuser) const
     case Refusal::Dominance:
       verdict.kind = ArchiveVerdict::Kind::Rejected;
       break;
-    case Refusal::Cell: // may not last: the entry can leave for a newcomer outside the cell
-      verdict.kind = ArchiveVerdict::Kind::Unknown;
+    case Refusal::Cell: // lasts while the entry stays (see Kind::Crowded)
+      verdict.kind = ArchiveVerdict::Kind::Crowded;
       break;
   }
   verdict.witness = m_Keys[refuser.index].serial;
@@ -306,12 +317,19 @@ ElitistArchive::Insert(const Fitness & f, const DualMesh & solution, std::uint64
 bool
 ElitistArchive::InsertAccepted(const Fitness & f, const DualMesh & solution, std::uint64_t id)
 {
-  std::vector<bool> keep(m_Keys.size());
-  for (std::size_t i = 0; i < m_Keys.size(); ++i)
-    keep[i] = !Dominates(f.objectives, m_Keys[i].objectives);
-  Compact(keep);
-  m_Entries.push_back(ArchiveEntry{ f, solution, id });
-  m_Keys.push_back(Key{ f.objectives, m_Insertions++ });
+  // Most newcomers dominate no entry, or a few: compact from the first.
+  std::size_t first = 0;
+  while (first < m_Keys.size() && !Dominates(f.objectives, m_Keys[first].objectives))
+    ++first;
+  std::vector<bool> keep;
+  if (first < m_Keys.size())
+  {
+    keep.assign(m_Keys.size(), true);
+    for (std::size_t i = first; i < m_Keys.size(); ++i)
+      keep[i] = !Dominates(f.objectives, m_Keys[i].objectives);
+    Compact(keep, first);
+  }
+  Append(f, solution, id);
   if (m_Entries.size() <= m_Capacity)
     return true;
 
@@ -332,24 +350,55 @@ ElitistArchive::InsertAccepted(const Fitness & f, const DualMesh & solution, std
   }
   const bool newcomerKept = keep.back();
   Compact(keep);
+  RefreshCells();
   // A newcomer thinned out at once did not improve the archive: report false.
   return newcomerKept;
 }
 
 void
-ElitistArchive::Compact(const std::vector<bool> & keep)
+ElitistArchive::Append(const Fitness & f, const DualMesh & solution, std::uint64_t id)
 {
-  std::size_t kept = 0;
-  for (std::size_t i = 0; i < m_Entries.size(); ++i)
+  ArchiveEntry entry{ f, {}, id };
+  if (!m_SpareMeshes.empty())
+  {
+    entry.solution = std::move(m_SpareMeshes.back());
+    m_SpareMeshes.pop_back();
+  }
+  entry.solution.source = solution.source; // into the spare's buffers
+  entry.solution.target = solution.target;
+  m_Entries.push_back(std::move(entry));
+  m_Keys.push_back(Key{ f.objectives, m_Insertions, m_Discretised ? CellOf(f.objectives, m_CellWidths) : Cell{} });
+  m_Present.push_back(true);
+  ++m_Insertions;
+}
+
+void
+ElitistArchive::RefreshCells()
+{
+  for (Key & k : m_Keys)
+    k.cell = m_Discretised ? CellOf(k.objectives, m_CellWidths) : Cell{};
+}
+
+void
+ElitistArchive::Compact(const std::vector<bool> & keep, std::size_t first)
+{
+  // A bound on the spares: a few batches' worth of newcomers.
+  constexpr std::size_t MaximumSpares = 64;
+  std::size_t           kept = first;
+  for (std::size_t i = first; i < m_Entries.size(); ++i)
     if (keep[i])
     {
-      if (kept != i) // a self-move would empty the meshes
+      if (kept != i) // a self-swap would be harmless; a self-move empties the meshes
       {
-        m_Entries[kept] = std::move(m_Entries[i]);
+        std::swap(m_Entries[kept], m_Entries[i]); // the removed one moves back
         m_Keys[kept] = m_Keys[i];
       }
       ++kept;
     }
+    else
+      m_Present[m_Keys[i].serial] = false;
+  for (std::size_t i = kept; i < m_Entries.size() && m_SpareMeshes.size() < MaximumSpares; ++i)
+    m_SpareMeshes.push_back(std::move(m_Entries[i].solution));
   m_Entries.resize(kept);
   m_Keys.resize(kept);
 }
@@ -390,12 +439,18 @@ ElitistArchive::Restore(std::vector<ArchiveEntry> entries, bool discretised, con
   if (entries.size() > m_Capacity)
     throw Error("elitist archive: cannot restore " + std::to_string(entries.size()) + " entries into a capacity of " +
                 std::to_string(m_Capacity));
+  for (const Key & k : m_Keys)
+    m_Present[k.serial] = false;
   m_Entries = std::move(entries);
   m_Keys.clear();
-  for (const ArchiveEntry & e : m_Entries)
-    m_Keys.push_back(Key{ e.fitness.objectives, m_Insertions++ });
   m_Discretised = discretised;
   m_CellWidths = cellWidths;
+  for (const ArchiveEntry & e : m_Entries)
+  {
+    m_Keys.push_back(Key{ e.fitness.objectives, m_Insertions++, Cell{} });
+    m_Present.push_back(true);
+  }
+  RefreshCells();
   ++m_Revision;
 }
 } // namespace morea

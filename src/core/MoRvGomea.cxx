@@ -1047,7 +1047,8 @@ MoRvGomea::AcceptCandidates(CandidateBatch & candidateBatch, const std::vector<P
   }
   // Chains whose guess the ordered pass overturned; their later candidates
   // are judged on the totals the solution then has.
-  std::vector<bool>   overturned(m_Population.size(), false);
+  std::vector<bool>         overturned(m_Population.size(), false);
+  std::vector<std::uint8_t> acceptedOf(m_Population.size(), 0);
   const std::uint64_t revision = m_Archive->ThinningRevision();
   std::size_t         accepted = 0;
   for (std::size_t b = 0; b < count; ++b)
@@ -1096,26 +1097,47 @@ MoRvGomea::AcceptCandidates(CandidateBatch & candidateBatch, const std::vector<P
     DualMesh &                solution = m_Population[s];
     const Vec3 *              source = candidateBatch.Source(c);
     const Vec3 *              target = candidateBatch.Target(c);
-    const TetrahedronValues * values = candidateBatch.Values(c);
     for (std::size_t k = 0; k < element.points.size(); ++k)
     {
       solution.source[element.points[k]] = source[k];
       solution.target[element.points[k]] = target[k];
-    }
-    const std::size_t elements = m_Parallel.elements.size();
-    for (std::size_t k = 0; k < element.dependentTetrahedra.size(); ++k)
-    {
-      const std::uint32_t t = element.dependentTetrahedra[k];
-      m_TetValues[s][t] = values[k];
-      for (std::uint32_t i = m_TetElementStart[t]; i < m_TetElementStart[t + 1]; ++i)
-        m_ElementSumStale[s * elements + m_TetElements[i]] = 1;
     }
     m_Totals[s] = totals;
     m_Ids[s] = m_NextId++;
     m_Archive->Insert(*next, solution, m_Ids[s], verdict);
     c.accepted = true;
     ++accepted;
+    acceptedOf[s] = 1;
   }
+  // The accepted candidates' tetrahedra's values, and the element sums they
+  // make stale, after the ordered pass and in parallel (scattered writes,
+  // most of them cache misses): nothing in this pass reads what another
+  // candidate of the solution changes, as they touch disjoint tetrahedra
+  // (and so disjoint elements' sums). One solution per task, so no two
+  // tasks mark one flag.
+  std::vector<std::uint32_t> changed;
+  for (std::size_t s = 0; s < m_Population.size(); ++s)
+    if (acceptedOf[s])
+      changed.push_back(static_cast<std::uint32_t>(s));
+  const std::size_t elements = m_Parallel.elements.size();
+  m_Pool->ParallelFor(changed.size(), [&](std::size_t k) {
+    const std::size_t s = changed[k];
+    for (std::size_t at = j.chainStart[s]; at < j.chainStart[s + 1]; ++at)
+    {
+      const Candidate & c = candidates[batchIndex[j.order[at]]];
+      if (!c.accepted)
+        continue;
+      const FosElement &        element = m_Parallel.elements[c.element];
+      const TetrahedronValues * values = candidateBatch.Values(c);
+      for (std::size_t i = 0; i < element.dependentTetrahedra.size(); ++i)
+      {
+        const std::uint32_t t = element.dependentTetrahedra[i];
+        m_TetValues[s][t] = values[i];
+        for (std::uint32_t e = m_TetElementStart[t]; e < m_TetElementStart[t + 1]; ++e)
+          m_ElementSumStale[s * elements + m_TetElements[e]] = 1;
+      }
+    }
+  });
   return accepted;
 }
 
