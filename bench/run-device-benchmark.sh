@@ -22,6 +22,8 @@
 #                  generations (bench/tools/main-thread-profiler.c); here,
 #                  bench/tools/profile-report.py OUTDIR/main-thread.prof --binary build/bin/morea
 #                  names the functions (with the build the bundle was made from).
+#   Whole runs: bench/run-device-benchmark.sh whole OUTDIR SECONDS BACKEND LABEL PROGRAM [OPTIONS]
+#                  registers from scratch with PROGRAM (e.g. /tmp/b/bin/morea-old) and OPTIONS.
 #   Refusal bound: bench/run-device-benchmark.sh bound OUTDIR SECONDS BACKEND GENERATIONS [ROUNDS [PROGRAM...]]
 #                  times late generations with --refusal-bound on and off in turns.
 set -euo pipefail
@@ -58,8 +60,13 @@ summary() {
   python3 - "$1" "$2" "$3" <<'EOF'
 import json, sys
 run = json.load(open(sys.argv[1]))["runs"][sys.argv[2]]
+# The first generation after a checkpoint is loaded pays for allocations
+# and page faults (about 0.3 s on an H100 host): the rest is what a run's
+# late generations cost.
+later = [g["seconds"] for g in run["per_generation"][1:]]
 print(f"{sys.argv[3]}: from generation {run['first_generation']}, {run['samples_per_second_kernel']:.4e} samples/s "
-      f"in kernels, {run['seconds_per_generation']:.4f} s per generation, {run['seconds_in_kernels']:.3f} s in "
+      f"in kernels, {run['seconds_per_generation']:.4f} s per generation "
+      f"({sum(later) / max(1, len(later)):.4f} after the first), {run['seconds_in_kernels']:.3f} s in "
       f"kernels, samples {run['samples']:.4g}, spared {run.get('bound_skipped_samples', 0):.4g}")
 EOF
 }
@@ -106,6 +113,32 @@ case "${1:-}" in
     tail -c 4000 "$run/register.log" | tee "$out/register-tail.log"
     cp "$run"/generations.csv "$run"/summary.json "$run"/front.csv "$out/" 2>/dev/null || true
     echo "register exit status $status (137: stopped after $seconds s; call again to resume)"
+    ;;
+  whole)
+    # One run of the paper's configuration from scratch by PROGRAM (the
+    # bundle's morea or an older build it carries) with OPTIONS, stopped
+    # after SECONDS; its per-generation record and front go to OUTDIR/LABEL.
+    # Several in one device command compare builds within one lease.
+    out=${2:?output folder}
+    seconds=${3:?seconds}
+    backend=${4:?backend}
+    label=${5:?label}
+    program=${6:?program}
+    shift 6
+    mkdir -p "$out/$label"
+    unpack_bundle
+    rm -rf "/tmp/whole/$label"
+    status=0
+    register "$program" "/tmp/whole/$label" "$seconds" "$backend" "$@" || status=$?
+    tail -c 2000 "/tmp/whole/$label/register.log" > "$out/$label/register-tail.log"
+    cp "/tmp/whole/$label"/generations.csv "/tmp/whole/$label"/summary.json "/tmp/whole/$label"/front.csv \
+      "$out/$label/" 2>/dev/null || true
+    python3 - "$out/$label/generations.csv" "$label" "$status" <<'EOF2'
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1]))) if __import__("os").path.exists(sys.argv[1]) else []
+total = sum(float(r["seconds"]) for r in rows)
+print(f"{sys.argv[2]}: exit {sys.argv[3]}, {len(rows)} generations, {total:.1f} s summed over them")
+EOF2
     ;;
   ab)
     # Variants of morea over the same late generations: the bundle's morea
@@ -227,7 +260,8 @@ case "${1:-}" in
     echo "usage: $0 bundle [PROGRAM...] | run OUTDIR [morea benchmark options] | register OUTDIR RUNDIR [SECONDS [BACKEND [OPTIONS]]]" \
       "| ab OUTDIR SECONDS BACKEND PROGRAM... | late OUTDIR SECONDS BACKEND [GENERATIONS]" \
       "| early OUTDIR GENERATIONS ROUNDS BACKEND PROGRAM... | profile OUTDIR SECONDS BACKEND GENERATIONS [OPTIONS]" \
-      "| bound OUTDIR SECONDS BACKEND GENERATIONS [ROUNDS [PROGRAM...]]" >&2
+      "| bound OUTDIR SECONDS BACKEND GENERATIONS [ROUNDS [PROGRAM...]]" \
+      "| whole OUTDIR SECONDS BACKEND LABEL PROGRAM [OPTIONS]" >&2
     exit 2
     ;;
 esac

@@ -1301,20 +1301,28 @@ MoRvGomea::RunGeneration()
   // batch just before its evaluation.
   const auto drawBatch = [&](std::size_t g, CandidateBatch & next) {
     const auto               sampling = std::chrono::steady_clock::now();
-    std::vector<Candidate> & candidates = next.candidates;
-    candidates.clear();
-    for (const Member & member : members)
-      for (std::uint32_t e : m_Parallel.groups[g])
+    std::vector<Candidate> &           candidates = next.candidates;
+    const std::vector<std::uint32_t> & group = m_Parallel.groups[g];
+    // Member by member, each one's elements in group order; the seeds drawn
+    // in that order, the rest filled in on the pool.
+    candidates.resize(members.size() * group.size());
+    for (Candidate & cand : candidates)
+      cand.seed = random.NextU64();
+    m_Pool->ParallelFor(members.size(), [&](std::size_t m) {
+      const Member & member = members[m];
+      for (std::size_t k = 0; k < group.size(); ++k)
       {
-        Candidate cand;
+        Candidate &         cand = candidates[m * group.size() + k];
+        const std::uint64_t seed = cand.seed;
+        cand = Candidate{};
         cand.solution = member.solution;
-        cand.element = e;
+        cand.element = group[k];
         cand.cluster = member.cluster;
         cand.singleObjective = clusters[member.cluster].singleObjective;
-        cand.seed = random.NextU64();
+        cand.seed = seed;
         cand.anticipate = member.anticipate;
-        candidates.push_back(cand);
       }
+    });
     SampleCandidates(next, clusters);
     record.phaseSeconds.sampling += SecondsSince(sampling);
   };
