@@ -134,8 +134,8 @@ case "${1:-}" in
     cp "/tmp/whole/$label"/generations.csv "/tmp/whole/$label"/summary.json "/tmp/whole/$label"/front.csv \
       "$out/$label/" 2>/dev/null || true
     python3 - "$out/$label/generations.csv" "$label" "$status" <<'EOF2'
-import csv, sys
-rows = list(csv.DictReader(open(sys.argv[1]))) if __import__("os").path.exists(sys.argv[1]) else []
+import csv, os, sys
+rows = list(csv.DictReader(open(sys.argv[1]))) if os.path.exists(sys.argv[1]) else []
 total = sum(float(r["seconds"]) for r in rows)
 print(f"{sys.argv[2]}: exit {sys.argv[3]}, {len(rows)} generations, {total:.1f} s summed over them")
 EOF2

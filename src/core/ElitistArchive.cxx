@@ -388,7 +388,7 @@ ElitistArchive::Compact(const std::vector<bool> & keep, std::size_t first)
   for (std::size_t i = first; i < m_Entries.size(); ++i)
     if (keep[i])
     {
-      if (kept != i) // a self-swap would be harmless; a self-move empties the meshes
+      if (kept != i)
       {
         std::swap(m_Entries[kept], m_Entries[i]); // the removed one moves back
         m_Keys[kept] = m_Keys[i];

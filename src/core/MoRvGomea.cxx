@@ -1049,6 +1049,7 @@ MoRvGomea::AcceptCandidates(CandidateBatch & candidateBatch, const std::vector<P
   // are judged on the totals the solution then has.
   std::vector<bool>         overturned(m_Population.size(), false);
   std::vector<std::uint8_t> acceptedOf(m_Population.size(), 0);
+  std::vector<std::uint32_t> changed; // the solutions with an accepted candidate
   const std::uint64_t revision = m_Archive->ThinningRevision();
   std::size_t         accepted = 0;
   for (std::size_t b = 0; b < count; ++b)
@@ -1107,6 +1108,8 @@ MoRvGomea::AcceptCandidates(CandidateBatch & candidateBatch, const std::vector<P
     m_Archive->Insert(*next, solution, m_Ids[s], verdict);
     c.accepted = true;
     ++accepted;
+    if (!acceptedOf[s])
+      changed.push_back(static_cast<std::uint32_t>(s));
     acceptedOf[s] = 1;
   }
   // The accepted candidates' tetrahedra's values, and the element sums they
@@ -1115,10 +1118,6 @@ MoRvGomea::AcceptCandidates(CandidateBatch & candidateBatch, const std::vector<P
   // candidate of the solution changes, as they touch disjoint tetrahedra
   // (and so disjoint elements' sums). One solution per task, so no two
   // tasks mark one flag.
-  std::vector<std::uint32_t> changed;
-  for (std::size_t s = 0; s < m_Population.size(); ++s)
-    if (acceptedOf[s])
-      changed.push_back(static_cast<std::uint32_t>(s));
   const std::size_t elements = m_Parallel.elements.size();
   m_Pool->ParallelFor(changed.size(), [&](std::size_t k) {
     const std::size_t s = changed[k];
