@@ -35,6 +35,11 @@ def load_symbols(path):
     return starts, names, segments
 
 
+def is_library(frame):
+    """A frame named by its library alone (no symbols for it)."""
+    return ".so" in frame and "(" not in frame or frame.startswith("[") or frame.startswith("libcudart_static")
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("profile")
@@ -128,9 +133,11 @@ def main():
         callers = collections.Counter()
         for s in samples:
             if s and args.callers_of in s[0]:
-                rest = [f for f in s if args.callers_of not in f]
+                # Libraries' own frames (libc, libcuda, the vDSO) say little
+                # about who called them: the first named function does.
+                rest = [f for f in s if args.callers_of not in f and not is_library(f)]
                 callers[rest[0] if rest else "?"] += 1
-        show(f"first caller outside '{args.callers_of}' of the innermost frames in it", callers)
+        show(f"first caller outside '{args.callers_of}' and libraries of the innermost frames in it", callers)
     if args.lines:
         # Source lines (the binary needs line tables: the bundle builds with
         # -g1) of the outermost frame in a function whose name holds TEXT:

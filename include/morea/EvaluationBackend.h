@@ -82,7 +82,7 @@ struct BackendStatistics
   double        samples{ 0.0 };     ///< sample points drawn, both directions
   double        seconds{ 0.0 };     ///< wall time inside the calls
   double        kernelSeconds{ 0.0 }; ///< device time of the kernels (CUDA only)
-  double        foldSeconds{ 0.0 };   ///< of the calls' time, fold checks and repair (CUDA: device time)
+  double        foldSeconds{ 0.0 };   ///< of the calls' time, fold checks and repair (CUDA: device time they cover)
   // CUDA only, host time of the partial evaluations: packing and uploading a
   // batch, waiting for the device, handing the results back.
   double stagingSeconds{ 0.0 };
@@ -114,8 +114,8 @@ struct BackendStatistics
     double betweenBatches{ 0.0 }; ///< a batch's end to the next one's start
     double staging{ 0.0 };        ///< start to the first upload: the host packing the batch
     double uploads{ 0.0 };        ///< fold-check staging, candidates and parents to the device
-    double foldChecks{ 0.0 };     ///< checks and repair
-    double preparation{ 0.0 };    ///< corners, screen, sampling set-up, and waits between ranges
+    double foldChecks{ 0.0 };     ///< checks and repair (the time they cover: parts' checks overlap)
+    double preparation{ 0.0 };    ///< corners, screen, sampling set-up, waits between ranges (what the rest leave)
     double chunkCounts{ 0.0 };    ///< 0: the sampling is sized on the device (once the host read chunk counts)
     double sampling{ 0.0 };       ///< the parts' sampling kernels
   } devicePhases;

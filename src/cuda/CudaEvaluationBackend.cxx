@@ -21,6 +21,7 @@
 #include "morea/ThreadPool.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -145,18 +146,22 @@ struct BatchFlight
 
   std::size_t items{ 0 };
   bool        checks{ false }; ///< the fold kernel runs
+  /** The time the parts' fold checks (side by side) covered, and the end
+   *  of the last one read so far, in seconds after `start`. */
+  double      foldSeconds{ 0.0 }, foldCovered{ 0.0 };
   bool        skipItems{ false }; ///< itemSkip is set (not for whole solutions)
   // Ranges of candidates and parts of items; a range's parts follow it.
   static constexpr std::size_t MaxRanges = 2;
   std::size_t                  ranges{ 0 };
-  std::size_t                  rangeBegin[MaxRanges]{}, rangeEnd[MaxRanges]{}, rangeFirstPart[MaxRanges]{};
+  std::size_t                  rangeFirstPart[MaxRanges]{};
   std::vector<std::size_t>     candidateBounds{ 0 }, itemBounds{ 0 }; ///< per part, and the end
   std::size_t                  sampledParts{ 0 };                      ///< parts whose sampling is queued
   std::vector<std::size_t>     chunkCapacity; ///< per part: room for chunks (texture path)
 
   cuda::Event start, staged, end;
-  cuda::Event rangeStart[MaxRanges], foldStart[MaxRanges], foldEnd[MaxRanges];
-  std::vector<std::unique_ptr<cuda::Event>> partEvents;   ///< per part: set-up start, end; sampling start, end
+  cuda::Event rangeStart[MaxRanges], rangeUploaded[MaxRanges];
+  /** Per part, PartStep apart: its fold checks, its sampling's set-up and its sampling, each start and end. */
+  std::vector<std::unique_ptr<cuda::Event>> partEvents;
   std::vector<std::unique_ptr<cuda::Event>> copiedEvents; ///< per part: its values on the host
 
   std::size_t
@@ -164,10 +169,20 @@ struct BatchFlight
   {
     return candidateBounds.size() - 1;
   }
-  cudaEvent_t
-  PartEvent(std::size_t p, int step) const
+  enum PartStep : std::size_t
   {
-    return partEvents[4 * p + static_cast<std::size_t>(step)]->Get();
+    FoldStart,
+    FoldEnd,
+    SetUpStart,
+    SetUpEnd,
+    SamplingStart,
+    SamplingEnd,
+    PartSteps
+  };
+  cudaEvent_t
+  PartEvent(std::size_t p, PartStep step) const
+  {
+    return partEvents[PartSteps * p + step]->Get();
   }
 };
 
@@ -202,6 +217,8 @@ public:
     Check(cudaSetDevice(0), "selecting device 0");
     m_Stream = std::make_unique<cuda::Stream>();
     m_CopyStream = std::make_unique<cuda::Stream>();
+    for (auto & stream : m_FoldStreams)
+      stream = std::make_unique<cuda::Stream>();
     m_FallbackStream = std::make_unique<cuda::Stream>(cuda::Stream::HighPriority{});
     for (auto & flight : m_Flights)
     {
@@ -848,13 +865,13 @@ private:
 
   /** Candidates [begin, end) of a batch whose tables are queued: the slots
    *  of the parents they use first, those parents (the ones the device does
-   *  not hold, see PartialCandidate::parentKey), which of them need no values
-   *  when left folded, then their fold checks, `foldStart` (if any) before them. The
-   *  whole batch is one range, or a head [0, h) the first call and the rest
-   *  the second (the store's slots are assigned in two steps then). */
+   *  not hold, see PartialCandidate::parentKey) and which of them need no
+   *  values when left folded. The whole batch is one range, or a head [0, h)
+   *  the first call and the rest the second (the store's slots are assigned
+   *  in two steps then). */
   void
   UploadRange(const std::vector<PartialCandidate> & candidates, HostCandidates & h, BatchFlight & f,
-              std::size_t begin, std::size_t end, cuda::Event & foldStart)
+              std::size_t begin, std::size_t end)
   {
     const bool checks = f.checks;
     // Parents are numbered by first use: those first used in the range are
@@ -882,7 +899,6 @@ private:
     Check(cudaMemcpyAsync(m_CandidateParent.Data() + begin, m_HostCandidateSlot.Data() + begin,
                           (end - begin) * sizeof(std::uint32_t), cudaMemcpyHostToDevice, stream),
           "copying a batch to the device");
-    Check(cudaEventRecord(foldStart.Get(), stream), "recording an event");
     if (!checks)
       return;
     m_Pool->ParallelFor(end - begin, [&](std::size_t k) {
@@ -892,8 +908,30 @@ private:
     Check(cudaMemcpyAsync(m_SkipIfFoldedDevice.Data() + begin, m_HostSkipIfFolded.Data() + begin, end - begin,
                           cudaMemcpyHostToDevice, stream),
           "copying a batch to the device");
-    cuda::LaunchCheckCandidateFolds(m_Batch, m_Folds, m_FoldCheck, m_SideSeeds, m_Moved.Data(), f.outcome.Data(),
-                                    begin, end - begin, stream);
+  }
+
+  /** The fold checks (and repair) of part `p` of flight `f` in range `r`,
+   *  between its fold events, on a fold stream after the range's uploads;
+   *  their outcome and repaired points' copy back. Part by part, so that
+   *  the first part's sampling and acceptance need not wait for the whole
+   *  range's checks (one launch per part on the sampling stream, each
+   *  waiting for its slowest sides, took the late generations' checks from
+   *  0.038 to 0.051 s on an H100). */
+  void
+  CheckPartFolds(HostCandidates & h, BatchFlight & f, std::size_t r, std::size_t p)
+  {
+    cudaStream_t main = m_Stream->Get();
+    cudaStream_t stream = f.checks ? m_FoldStreams[p % MaxParts]->Get() : main;
+    if (f.checks)
+      Check(cudaStreamWaitEvent(stream, f.rangeUploaded[r].Get(), 0), "ordering fold checks after their uploads");
+    Check(cudaEventRecord(f.PartEvent(p, BatchFlight::FoldStart), stream), "recording an event");
+    const std::size_t begin = f.candidateBounds[p], end = f.candidateBounds[p + 1];
+    if (f.checks)
+      cuda::LaunchCheckCandidateFolds(m_Batch, m_Folds, m_FoldCheck, m_SideSeeds, m_Moved.Data(), f.outcome.Data(),
+                                      begin, end - begin, stream);
+    Check(cudaEventRecord(f.PartEvent(p, BatchFlight::FoldEnd), stream), "recording an event");
+    if (f.checks)
+      CopyFoldChecksBack(h, f, p);
   }
 
   /** A started head must be what the call passes: the same parents' keys
@@ -952,20 +990,21 @@ private:
     cuda::LaunchScatterParents(staged, slotsOnDevice, count, perParent, m_Parents.Data(), m_Stream->Get());
   }
 
-  /** The fold checks' outcome and the repaired points of range `r` back to
-   *  the host, after them (read when the range's first part is handed
-   *  over). The checks run on the sampling stream, before the corners: run
-   *  part by part on a second stream beside the sampling, the two kernels
-   *  slowed each other down more than they overlapped (H100, paper
-   *  configuration: 192.9 s against 184.2 s for 500 generations). */
+  /** The fold checks' outcome and the repaired points of part `p` back to
+   *  the host, after them (read when the part is handed over). The checks
+   *  run on the sampling stream, before the part's corners: run on a second
+   *  stream beside the sampling, the two kernels slowed each other down more
+   *  than they overlapped (H100, paper configuration: 192.9 s against 184.2 s
+   *  for 500 generations). */
   void
-  CopyFoldChecksBack(HostCandidates & h, BatchFlight & f, std::size_t r)
+  CopyFoldChecksBack(HostCandidates & h, BatchFlight & f, std::size_t p)
   {
     // On the copy stream, so that the corners need not wait for the
-    // transfer; it goes before the range's values on that stream.
+    // transfer; it goes before the part's values on that stream.
     cudaStream_t      copies = m_CopyStream->Get();
-    const std::size_t begin = f.rangeBegin[r], end = f.rangeEnd[r];
-    Check(cudaStreamWaitEvent(copies, f.foldEnd[r].Get(), 0), "ordering the fold checks' copy after them");
+    const std::size_t begin = f.candidateBounds[p], end = f.candidateBounds[p + 1];
+    Check(cudaStreamWaitEvent(copies, f.PartEvent(p, BatchFlight::FoldEnd), 0),
+          "ordering the fold checks' copy after them");
     Check(cudaMemcpyAsync(f.hostOutcome.Data() + 2 * begin, f.outcome.Data() + 2 * begin, 2 * (end - begin),
                           cudaMemcpyDeviceToHost, copies),
           "copying fold checks from the device");
@@ -979,12 +1018,12 @@ private:
           "copying repaired points from the device");
   }
 
-  /** The fold outcome of range `r`'s candidates, their repaired points in place. */
+  /** The fold outcome of part `p`'s candidates, their repaired points in place. */
   void
-  ReadFoldChecks(const std::vector<PartialCandidate> & candidates, const HostCandidates & h, const BatchFlight & f,
-                 std::size_t r)
+  ReadFoldChecks(const std::vector<PartialCandidate> & candidates, const HostCandidates & h, BatchFlight & f,
+                 std::size_t p)
   {
-    const std::size_t begin = f.rangeBegin[r], end = f.rangeEnd[r];
+    const std::size_t begin = f.candidateBounds[p], end = f.candidateBounds[p + 1];
     if (!f.checks)
     {
       for (std::size_t i = begin; i < end; ++i)
@@ -992,7 +1031,13 @@ private:
           *candidates[i].folds = CandidateFolds{}; // no dependent tetrahedra, nothing checked
       return;
     }
-    m_Statistics.foldSeconds += ElapsedSeconds(f.foldStart[r], f.foldEnd[r]);
+    // Parts' checks overlap: count the time they cover once.
+    const double from = ElapsedSeconds(f.start.Get(), f.PartEvent(p, BatchFlight::FoldStart));
+    const double to = ElapsedSeconds(f.start.Get(), f.PartEvent(p, BatchFlight::FoldEnd));
+    const double covered = std::max(0.0, to - std::max(from, f.foldCovered));
+    f.foldCovered = std::max(f.foldCovered, to);
+    f.foldSeconds += covered;
+    m_Statistics.foldSeconds += covered;
     // On the pool: most candidates of a late batch have a folded side to
     // copy back (serial, it took 10 ms of each paper-scale generation).
     m_Pool->ParallelFor(end - begin, [&](std::size_t j) {
@@ -1133,21 +1178,21 @@ private:
     const std::size_t parts = f.Parts();
     double            folds = 0.0, uploads = ElapsedSeconds(f.staged, f.rangeStart[0]);
     for (std::size_t r = 0; r < f.ranges; ++r)
-    {
-      const double fold = f.checks ? ElapsedSeconds(f.foldStart[r], f.foldEnd[r]) : 0.0;
-      folds += fold;
-      uploads += ElapsedSeconds(f.rangeStart[r], f.foldEnd[r]) - fold;
-    }
+      uploads += ElapsedSeconds(f.rangeStart[r], f.rangeUploaded[r]);
     const double span = ElapsedSeconds(f.start, f.end);
     const double staging = ElapsedSeconds(f.start, f.staged);
     double       sampling = 0.0;
     for (std::size_t p = 0; p < parts; ++p)
-      sampling += ElapsedSeconds(f.PartEvent(p, 2), f.PartEvent(p, 3));
+      sampling +=
+        ElapsedSeconds(f.PartEvent(p, BatchFlight::SamplingStart), f.PartEvent(p, BatchFlight::SamplingEnd));
+    if (f.checks)
+      folds = f.foldSeconds;
     phases.staging += staging;
     phases.uploads += uploads;
     phases.foldChecks += folds;
     phases.sampling += sampling;
-    // Corners, screen and set-up, and whatever the device waited for between the ranges.
+    // Corners, screen and set-up, and whatever the device waited for between
+    // the ranges: what the rest leave (fold checks overlap other parts' work).
     phases.preparation += std::max(0.0, span - staging - uploads - folds - sampling);
   }
 
@@ -1178,6 +1223,7 @@ private:
     Check(cudaEventRecord(f.start.Get(), m_Stream->Get()), "recording an event");
     f.items = h.firstItem[n];
     f.checks = f.items > 0 && UploadTables(candidates, h, f.staged);
+    f.foldSeconds = f.foldCovered = 0.0;
     if (f.items == 0)
       Check(cudaEventRecord(f.staged.Get(), m_Stream->Get()), "recording an event");
     f.skipItems = true;
@@ -1206,9 +1252,10 @@ private:
   }
 
   /** Queues candidates [begin, end) of the batch begun on flight `f`: their
-   *  parents, fold checks (and the outcome's copy back), corners, screen,
-   *  and the set-up of their parts' sampling (texture path). `last`: the
-   *  batch's last range, whose last part is smaller. */
+   *  parents, then part by part the fold checks (and the outcome's copy
+   *  back), corners, screen, sampling set-up (texture path), sampling and
+   *  the values' copy back. `last`: the batch's last range, whose last part
+   *  is smaller. */
   void
   QueueRange(const std::vector<PartialCandidate> & candidates, HostCandidates & h, BatchFlight & f, std::size_t begin,
              std::size_t end, bool last)
@@ -1217,36 +1264,11 @@ private:
       throw Error("CUDA backend: a batch goes up in at most two ranges");
     cudaStream_t      stream = m_Stream->Get();
     const std::size_t r = f.ranges++;
-    f.rangeBegin[r] = begin;
-    f.rangeEnd[r] = end;
     f.rangeFirstPart[r] = f.Parts();
     Check(cudaEventRecord(f.rangeStart[r].Get(), stream), "recording an event");
     if (f.items > 0)
-    {
-      UploadRange(candidates, h, f, begin, end, f.foldStart[r]);
-      Check(cudaEventRecord(f.foldEnd[r].Get(), stream), "recording an event");
-      if (f.checks)
-        CopyFoldChecksBack(h, f, r);
-      // Candidates left folded that need no values are not sampled (as on
-      // the CPU): late in a run, about a third of a batch's tetrahedra.
-      cuda::FoldedCandidateSkip skip;
-      if (f.checks)
-      {
-        skip.skipIfFolded = m_SkipIfFolded;
-        skip.outcome = f.outcome.Data();
-      }
-      cuda::CandidateBatch range = m_Batch;
-      range.firstCandidate = begin;
-      range.candidates = end;
-      cuda::LaunchGatherCandidateCorners(range, f.items, skip, f.corners.Data(), f.tetrahedra.Data(),
-                                         f.itemSkip.Data(), stream);
-      ScreenRange(candidates, f, range);
-    }
-    else
-    {
-      Check(cudaEventRecord(f.foldStart[r].Get(), stream), "recording an event");
-      Check(cudaEventRecord(f.foldEnd[r].Get(), stream), "recording an event");
-    }
+      UploadRange(candidates, h, f, begin, end);
+    Check(cudaEventRecord(f.rangeUploaded[r].Get(), stream), "recording an event");
     // Parts of whole candidates with about equal numbers of items, the
     // batch's last one smaller.
     const std::uint64_t * first = h.firstItem.Data();
@@ -1265,15 +1287,46 @@ private:
     }
     f.candidateBounds.push_back(end);
     f.itemBounds.push_back(first[end]);
+    // Candidates left folded that need no values are not sampled (as on
+    // the CPU): late in a run, about a third of a batch's tetrahedra.
+    cuda::FoldedCandidateSkip skip;
+    if (f.checks)
+    {
+      skip.skipIfFolded = m_SkipIfFolded;
+      skip.outcome = f.outcome.Data();
+    }
     for (std::size_t p = f.rangeFirstPart[r]; p < f.Parts(); ++p)
+    {
+      ReservePart(f, p);
+      CheckPartFolds(h, f, r, p);
+    }
+    for (std::size_t p = f.rangeFirstPart[r]; p < f.Parts(); ++p)
+    {
+      if (f.checks)
+        Check(cudaStreamWaitEvent(stream, f.PartEvent(p, BatchFlight::FoldEnd), 0),
+              "ordering corners after fold checks");
+      if (f.items > 0)
+      {
+        cuda::CandidateBatch part = m_Batch;
+        part.firstCandidate = f.candidateBounds[p];
+        part.candidates = f.candidateBounds[p + 1];
+        cuda::LaunchGatherCandidateCorners(part, f.items, skip, f.corners.Data(), f.tetrahedra.Data(),
+                                           f.itemSkip.Data(), stream);
+        ScreenRange(candidates, f, part);
+      }
       PreparePart(f, p);
+      SamplePart(f, p);
+    }
+    f.sampledParts = f.Parts();
   }
 
-  /** Events and, on the texture path, the sampling set-up of part `p`. */
+  /** Events, workspaces and room for part `p` of flight `f`. */
   void
-  PreparePart(BatchFlight & f, std::size_t p)
+  ReservePart(BatchFlight & f, std::size_t p)
   {
-    while (f.partEvents.size() < 4 * (p + 1))
+    if (p >= BatchFlight::MaxRanges * MaxParts)
+      throw Error("CUDA backend: a batch in more parts than its ranges allow");
+    while (f.partEvents.size() < BatchFlight::PartSteps * (p + 1))
       f.partEvents.push_back(std::make_unique<cuda::Event>());
     while (f.copiedEvents.size() < p + 1)
       f.copiedEvents.push_back(std::make_unique<cuda::Event>());
@@ -1282,67 +1335,78 @@ private:
       f.workspaces.push_back(std::make_unique<cuda::DeviceArray<unsigned char>>());
       f.chunkWorkspaces.push_back(std::make_unique<cuda::DeviceArray<unsigned char>>());
     }
-    if (p >= BatchFlight::MaxRanges * MaxParts)
-      throw Error("CUDA backend: a batch in more parts than its ranges allow");
+    if (f.chunkCapacity.size() < p + 1)
+      f.chunkCapacity.resize(p + 1, 0);
+  }
+
+  /** On the texture path, the sampling set-up of part `p`. */
+  void
+  PreparePart(BatchFlight & f, std::size_t p)
+  {
+    ReservePart(f, p);
     f.hostChunks[p] = 0; // stays 0 for a part without items
     if (!UsesTexturePath())
       return;
     cudaStream_t      stream = m_Stream->Get();
     const std::size_t begin = f.itemBounds[p], count = f.itemBounds[p + 1] - begin;
     f.workspaces[p]->Reserve(std::max<std::size_t>(1, cuda::TexturePrepareWorkspaceBytes(count)));
-    Check(cudaEventRecord(f.PartEvent(p, 0), stream), "recording an event");
+    Check(cudaEventRecord(f.PartEvent(p, BatchFlight::SetUpStart), stream), "recording an event");
     cuda::LaunchPrepareTexture(m_Constants, f.corners.Data() + begin * cuda::ItemCorners, f.tetrahedra.Data() + begin,
                                f.skipItems ? f.itemSkip.Data() + begin : nullptr, count, f.workspaces[p]->Data(),
                                f.itemValues.Data() + begin * cuda::ItemValues, f.hostChunks.Data() + p, stream);
-    Check(cudaEventRecord(f.PartEvent(p, 1), stream), "recording an event");
+    Check(cudaEventRecord(f.PartEvent(p, BatchFlight::SetUpEnd), stream), "recording an event");
   }
 
-  /** Queues the sampling of the parts of flight `f` not yet queued and their
-   *  values' copy to the host, then f.end. On the texture path the host does
-   *  not wait for the parts' numbers of chunks: each part gets room for the
-   *  most chunks per item seen so far, and one with more is sampled again
-   *  when handed over (CompleteOverflowingPart). */
+  /** Queues the sampling of part `p` of flight `f`, set up, and its values'
+   *  copy to the host. On the texture path the host does not wait for the
+   *  part's number of chunks: it gets room for the most chunks per item seen
+   *  so far, and one with more is sampled again when handed over
+   *  (CompleteOverflowingPart). */
+  void
+  SamplePart(BatchFlight & f, std::size_t p)
+  {
+    cudaStream_t      stream = m_Stream->Get(), copies = m_CopyStream->Get();
+    const std::size_t begin = f.itemBounds[p], count = f.itemBounds[p + 1] - begin;
+    double *          itemValues = f.itemValues.Data() + begin * cuda::ItemValues;
+    double *          directionValues = f.directionValues.Data() + begin * 2 * cuda::DirectionValues;
+    if (UsesTexturePath())
+    {
+      const auto capacity = static_cast<std::size_t>(std::ceil(m_ChunksPerItem * static_cast<double>(count))) + 1024;
+      f.chunkCapacity[p] = capacity;
+      f.chunkWorkspaces[p]->Reserve(cuda::TextureChunkWorkspaceBytes(capacity));
+      Check(cudaEventRecord(f.PartEvent(p, BatchFlight::SamplingStart), stream), "recording an event");
+      cuda::LaunchSampleTexture(m_Constants, count, f.workspaces[p]->Data(), capacity, f.chunkWorkspaces[p]->Data(),
+                                directionValues, stream);
+    }
+    else
+    {
+      Check(cudaEventRecord(f.PartEvent(p, BatchFlight::SamplingStart), stream), "recording an event");
+      cuda::LaunchEvaluateTetrahedra(m_Constants, f.corners.Data() + begin * cuda::ItemCorners,
+                                     f.tetrahedra.Data() + begin, f.skipItems ? f.itemSkip.Data() + begin : nullptr,
+                                     count, itemValues, directionValues, stream);
+    }
+    Check(cudaEventRecord(f.PartEvent(p, BatchFlight::SamplingEnd), stream), "recording an event");
+    // The values go back on the copy stream, so that the next part's
+    // kernels do not wait for the transfer (about 70 bytes per tetrahedron).
+    Check(cudaStreamWaitEvent(copies, f.PartEvent(p, BatchFlight::SamplingEnd), 0), "ordering a copy after its part");
+    Check(cudaMemcpyAsync(f.hostItemValues.Data() + begin * cuda::ItemValues, itemValues,
+                          count * cuda::ItemValues * sizeof(double), cudaMemcpyDeviceToHost, copies),
+          "copying values from the device");
+    Check(cudaMemcpyAsync(f.hostDirectionValues.Data() + begin * 2 * cuda::DirectionValues, directionValues,
+                          count * 2 * cuda::DirectionValues * sizeof(double), cudaMemcpyDeviceToHost, copies),
+          "copying values from the device");
+    Check(cudaEventRecord(f.copiedEvents[p]->Get(), copies), "recording an event");
+  }
+
+  /** Queues the sampling of the parts of flight `f` not yet queued (see
+   *  SamplePart), then f.end. */
   void
   QueueSampling(BatchFlight & f)
   {
-    const std::size_t parts = f.Parts();
-    cudaStream_t      stream = m_Stream->Get(), copies = m_CopyStream->Get();
-    f.chunkCapacity.resize(parts, 0);
-    for (std::size_t p = f.sampledParts; p < parts; ++p)
-    {
-      const std::size_t begin = f.itemBounds[p], count = f.itemBounds[p + 1] - begin;
-      double *          itemValues = f.itemValues.Data() + begin * cuda::ItemValues;
-      double *          directionValues = f.directionValues.Data() + begin * 2 * cuda::DirectionValues;
-      if (UsesTexturePath())
-      {
-        const auto capacity = static_cast<std::size_t>(std::ceil(m_ChunksPerItem * static_cast<double>(count))) + 1024;
-        f.chunkCapacity[p] = capacity;
-        f.chunkWorkspaces[p]->Reserve(cuda::TextureChunkWorkspaceBytes(capacity));
-        Check(cudaEventRecord(f.PartEvent(p, 2), stream), "recording an event");
-        cuda::LaunchSampleTexture(m_Constants, count, f.workspaces[p]->Data(), capacity, f.chunkWorkspaces[p]->Data(),
-                                  directionValues, stream);
-      }
-      else
-      {
-        Check(cudaEventRecord(f.PartEvent(p, 2), stream), "recording an event");
-        cuda::LaunchEvaluateTetrahedra(m_Constants, f.corners.Data() + begin * cuda::ItemCorners,
-                                       f.tetrahedra.Data() + begin, f.skipItems ? f.itemSkip.Data() + begin : nullptr,
-                                       count, itemValues, directionValues, stream);
-      }
-      Check(cudaEventRecord(f.PartEvent(p, 3), stream), "recording an event");
-      // The values go back on the copy stream, so that the next part's
-      // kernels do not wait for the transfer (about 70 bytes per tetrahedron).
-      Check(cudaStreamWaitEvent(copies, f.PartEvent(p, 3), 0), "ordering a copy after its part");
-      Check(cudaMemcpyAsync(f.hostItemValues.Data() + begin * cuda::ItemValues, itemValues,
-                            count * cuda::ItemValues * sizeof(double), cudaMemcpyDeviceToHost, copies),
-            "copying values from the device");
-      Check(cudaMemcpyAsync(f.hostDirectionValues.Data() + begin * 2 * cuda::DirectionValues, directionValues,
-                            count * 2 * cuda::DirectionValues * sizeof(double), cudaMemcpyDeviceToHost, copies),
-            "copying values from the device");
-      Check(cudaEventRecord(f.copiedEvents[p]->Get(), copies), "recording an event");
-    }
-    f.sampledParts = parts;
-    Check(cudaEventRecord(f.end.Get(), stream), "recording an event");
+    for (std::size_t p = f.sampledParts; p < f.Parts(); ++p)
+      SamplePart(f, p);
+    f.sampledParts = f.Parts();
+    Check(cudaEventRecord(f.end.Get(), m_Stream->Get()), "recording an event");
   }
 
   /** Part `p` of flight `f`, whose values are on the host, sampled again
@@ -1392,9 +1456,7 @@ private:
       if (p == 0 && f.items > 0 && m_PreviousFlight)
         m_Statistics.devicePhases.betweenBatches += ElapsedSeconds(m_PreviousFlight->end, f.start);
       const auto unpack = std::chrono::steady_clock::now();
-      for (std::size_t r = 0; r < f.ranges; ++r)
-        if (f.rangeFirstPart[r] == p)
-          ReadFoldChecks(candidates, h, f, r);
+      ReadFoldChecks(candidates, h, f, p);
       const std::size_t begin = f.candidateBounds[p], end = f.candidateBounds[p + 1];
       skippedItems += UnpackRange(
         f, first, begin, end,
@@ -1433,8 +1495,10 @@ private:
     for (std::size_t p = 0; p < f.Parts(); ++p)
     {
       if (UsesTexturePath())
-        m_Statistics.kernelSeconds += ElapsedSeconds(f.PartEvent(p, 0), f.PartEvent(p, 1));
-      m_Statistics.kernelSeconds += ElapsedSeconds(f.PartEvent(p, 2), f.PartEvent(p, 3));
+        m_Statistics.kernelSeconds +=
+          ElapsedSeconds(f.PartEvent(p, BatchFlight::SetUpStart), f.PartEvent(p, BatchFlight::SetUpEnd));
+      m_Statistics.kernelSeconds +=
+        ElapsedSeconds(f.PartEvent(p, BatchFlight::SamplingStart), f.PartEvent(p, BatchFlight::SamplingEnd));
     }
   }
 
@@ -1507,6 +1571,11 @@ private:
   std::shared_ptr<ThreadPool> m_Pool;
   std::unique_ptr<cuda::Stream> m_Stream;
   std::unique_ptr<cuda::Stream> m_CopyStream; ///< the parts' values back to the host
+  /** The parts' fold checks, part p on stream p % MaxParts: a range's parts
+   *  run side by side, so that one part's slowest sides (ten rounds of
+   *  repair) do not hold the device idle, yet each part's corners and
+   *  sampling wait for its own checks only. */
+  std::array<std::unique_ptr<cuda::Stream>, MaxParts> m_FoldStreams;
   std::unique_ptr<BatchFlight>  m_Flights[2]; ///< as m_HostCandidates: the batch in flight, the next one
   const BatchFlight *           m_PreviousFlight{ nullptr }; ///< the last batch handed over, for its end
   double                        m_ChunksPerItem{ 6.0 }; ///< room for chunks per item: the most seen, with a margin
