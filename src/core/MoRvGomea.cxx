@@ -778,11 +778,16 @@ MoRvGomea::BuildPartials(CandidateBatch & candidateBatch) const
   const std::vector<Candidate> & candidates = candidateBatch.candidates;
   std::vector<PartialCandidate> & batch = candidateBatch.partials;
   batch.resize(candidates.size());
-  candidateBatch.folds.assign(candidates.size(), CandidateFolds{});
-  candidateBatch.bounds.assign(m_Options.boundRefusals ? candidates.size() : 0, RefusalBound{});
+  // Sized here, reset on the pool: a serial fill of a paper-scale
+  // generation's bounds took about 3 ms of it.
+  candidateBatch.folds.resize(candidates.size());
+  candidateBatch.bounds.resize(m_Options.boundRefusals ? candidates.size() : 0);
   m_Pool->ParallelFor(candidates.size(), [&](std::size_t i) {
     const Candidate &  c = candidates[i];
     PartialCandidate & p = batch[i];
+    candidateBatch.folds[i] = CandidateFolds{};
+    if (m_Options.boundRefusals)
+      candidateBatch.bounds[i] = RefusalBound{};
     p.parent = &m_Population[c.solution];
     p.parentKey = 0;
     p.element = &m_Parallel.elements[c.element];
