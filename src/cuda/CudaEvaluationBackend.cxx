@@ -219,6 +219,7 @@ public:
     m_CopyStream = std::make_unique<cuda::Stream>();
     for (auto & stream : m_FoldStreams)
       stream = std::make_unique<cuda::Stream>();
+    m_MovedCopied = std::make_unique<cuda::Event>();
     m_FallbackStream = std::make_unique<cuda::Stream>(cuda::Stream::HighPriority{});
     for (auto & flight : m_Flights)
     {
@@ -849,6 +850,9 @@ private:
     m_Batch.candidateElement = UploadAsync(h.candidateElement.Data(), n, m_CandidateElement);
     m_Batch.candidateMoved = UploadAsync(h.candidateMoved.Data(), n, m_CandidateMoved);
     m_Batch.candidateFirstItem = UploadAsync(h.firstItem.Data(), n + 1, m_FirstItem);
+    // The next batch's moved points go up only once the last repaired
+    // ones came back (on the copy stream, behind earlier parts' values).
+    Check(cudaStreamWaitEvent(m_Stream->Get(), m_MovedCopied->Get(), 0), "ordering moved points after their copy back");
     m_Batch.moved = UploadAsync(h.moved.Data(), 6 * h.movedPoints, m_Moved);
     m_MovedCount = 6 * h.movedPoints;
     m_Batch.candidates = n;
@@ -991,11 +995,11 @@ private:
   }
 
   /** The fold checks' outcome and the repaired points of part `p` back to
-   *  the host, after them (read when the part is handed over). The checks
-   *  run on the sampling stream, before the part's corners: run on a second
-   *  stream beside the sampling, the two kernels slowed each other down more
-   *  than they overlapped (H100, paper configuration: 192.9 s against 184.2 s
-   *  for 500 generations). */
+   *  the host, after them (read when the part is handed over). (An early
+   *  version checked part p + 1 on one second stream beside part p's
+   *  sampling; with the kernels of then, the two slowed each other down more
+   *  than they overlapped: 192.9 s against 184.2 s for 500 generations on an
+   *  H100.) */
   void
   CopyFoldChecksBack(HostCandidates & h, BatchFlight & f, std::size_t p)
   {
@@ -1016,6 +1020,7 @@ private:
     Check(cudaMemcpyAsync(h.moved.Data() + from, m_Moved.Data() + from, (to - from) * sizeof(double),
                           cudaMemcpyDeviceToHost, copies),
           "copying repaired points from the device");
+    Check(cudaEventRecord(m_MovedCopied->Get(), copies), "recording an event");
   }
 
   /** The fold outcome of part `p`'s candidates, their repaired points in place. */
@@ -1576,6 +1581,9 @@ private:
    *  repair) do not hold the device idle, yet each part's corners and
    *  sampling wait for its own checks only. */
   std::array<std::unique_ptr<cuda::Stream>, MaxParts> m_FoldStreams;
+  /** On the copy stream, after the last repaired points' copy back (made
+   *  once a device is known to be there, as the streams are). */
+  std::unique_ptr<cuda::Event> m_MovedCopied;
   std::unique_ptr<BatchFlight>  m_Flights[2]; ///< as m_HostCandidates: the batch in flight, the next one
   const BatchFlight *           m_PreviousFlight{ nullptr }; ///< the last batch handed over, for its end
   double                        m_ChunksPerItem{ 6.0 }; ///< room for chunks per item: the most seen, with a margin
