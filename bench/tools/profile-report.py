@@ -37,7 +37,7 @@ def load_symbols(path):
 
 def is_library(frame):
     """A frame named by its library alone (no symbols for it)."""
-    return ".so" in frame and "(" not in frame or frame.startswith("[") or frame.startswith("libcudart_static")
+    return (".so" in frame and "(" not in frame) or frame.startswith(("[", "libcudart_static"))
 
 
 def main():
