@@ -68,11 +68,14 @@ private:
   std::size_t                              m_Count{ 0 };
   std::size_t                              m_Grain{ 1 };
   std::atomic<bool>                        m_Stop{ false };
-  // Sleeping workers, woken under the mutex.
-  std::mutex              m_Mutex;
-  std::condition_variable m_Wake;
-  std::atomic<int>        m_Sleeping{ 0 };
-  std::exception_ptr      m_Error; ///< under m_Mutex
+  // Sleeping workers wait for m_WakeWord to change (ThreadPool.cxx); the
+  // condition variable serves where there is no futex.
+  std::atomic<std::uint32_t> m_WakeWord{ 0 };
+  std::atomic<int>           m_Sleeping{ 0 };
+  std::mutex                 m_Mutex;
+  std::condition_variable    m_Wake;
+  std::exception_ptr         m_Error;           ///< under m_Mutex
+  std::atomic<bool>          m_Failed{ false }; ///< m_Error is set
 };
 } // namespace morea
 
