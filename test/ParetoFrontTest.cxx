@@ -3,6 +3,7 @@
 #include "morea/Error.h"
 #include "morea/ParetoFront.h"
 #include "morea/Random.h"
+#include "morea/ThreadPool.h"
 
 #include <gtest/gtest.h>
 
@@ -133,6 +134,28 @@ TEST(ParetoFront, RanksAgreeWithDefinitionOnRandomPopulation)
       }
     EXPECT_TRUE(ranks[i] == 0 || dominatedByPreviousRank) << i;
   }
+}
+
+TEST(ParetoFront, RanksOnAPoolAreThoseOfOneThread)
+{
+  // Many ties and fronts: objectives on a coarse grid, a third infeasible.
+  morea::RandomGenerator random(11);
+  std::vector<Fitness>   population;
+  for (int i = 0; i < 700; ++i)
+  {
+    Fitness f = Feasible(std::floor(random.Uniform(0.0, 6.0)), std::floor(random.Uniform(0.0, 6.0)),
+                         std::floor(random.Uniform(0.0, 6.0)));
+    if (random.Uniform() < 0.3)
+    {
+      f.feasible = false;
+      f.constraint = std::floor(random.Uniform(0.0, 4.0));
+    }
+    population.push_back(f);
+  }
+  const auto       single = morea::NonDominatedRanks(population);
+  morea::ThreadPool pool(4);
+  EXPECT_EQ(morea::NonDominatedRanks(population, &pool), single);
+  EXPECT_GT(*std::max_element(single.begin(), single.end()), 3u) << "several fronts";
 }
 
 TEST(ParetoFront, HypervolumeOfHandComputedSets)

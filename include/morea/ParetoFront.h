@@ -55,9 +55,12 @@ Dominates(const ObjectiveVector & a, const ObjectiveVector & b)
 bool
 ConstraintDominates(const Fitness & a, const Fitness & b);
 
-/** Non-domination rank under constraint domination: 0 for the first front. */
+class ThreadPool;
+
+/** Non-domination rank under constraint domination: 0 for the first front.
+ *  With a pool, the comparisons run on it (the ranks are the same). */
 std::vector<std::size_t>
-NonDominatedRanks(const std::vector<Fitness> & population);
+NonDominatedRanks(const std::vector<Fitness> & population, ThreadPool * pool = nullptr);
 
 /** Hypervolume dominated by `points` and bounded by `reference` (3 objectives,
  *  exact). Points not strictly better than the reference in every objective

@@ -1,6 +1,7 @@
 #include "morea/ParetoFront.h"
 
 #include "morea/Error.h"
+#include "morea/ThreadPool.h"
 
 #include <algorithm>
 #include <cmath>
@@ -158,27 +159,32 @@ ConstraintDominates(const Fitness & a, const Fitness & b)
 }
 
 std::vector<std::size_t>
-NonDominatedRanks(const std::vector<Fitness> & population)
+NonDominatedRanks(const std::vector<Fitness> & population, ThreadPool * pool)
 {
   // Deb's fast non-dominated sort: count who dominates each solution, then peel
-  // fronts off by releasing the solutions each front dominates.
+  // fronts off by releasing the solutions each front dominates. Each solution
+  // is compared with all others on its own (twice the comparisons of taking
+  // each pair once, but rows side by side on the pool: a paper-scale
+  // population's sort took about 4 ms of every generation on one thread).
   const std::size_t                       n = population.size();
   std::vector<std::vector<std::uint32_t>> dominatedBy(n); // i -> solutions i dominates
   std::vector<std::size_t>                dominatorCount(n, 0);
-  for (std::size_t i = 0; i < n; ++i)
-    for (std::size_t k = i + 1; k < n; ++k)
+  const auto                              row = [&](std::size_t i) {
+    for (std::size_t k = 0; k < n; ++k)
     {
+      if (k == i)
+        continue;
       if (ConstraintDominates(population[i], population[k]))
-      {
         dominatedBy[i].push_back(static_cast<std::uint32_t>(k));
-        ++dominatorCount[k];
-      }
       else if (ConstraintDominates(population[k], population[i]))
-      {
-        dominatedBy[k].push_back(static_cast<std::uint32_t>(i));
         ++dominatorCount[i];
-      }
     }
+  };
+  if (pool)
+    pool->ParallelFor(n, row);
+  else
+    for (std::size_t i = 0; i < n; ++i)
+      row(i);
 
   std::vector<std::size_t> ranks(n, 0);
   std::vector<std::size_t> front;
