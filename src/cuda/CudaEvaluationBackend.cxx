@@ -1181,7 +1181,8 @@ private:
   {
     auto &            phases = m_Statistics.devicePhases;
     const std::size_t parts = f.Parts();
-    double            folds = 0.0, uploads = ElapsedSeconds(f.staged, f.rangeStart[0]);
+    const double      folds = f.foldSeconds; // 0 without checks
+    double            uploads = ElapsedSeconds(f.staged, f.rangeStart[0]);
     for (std::size_t r = 0; r < f.ranges; ++r)
       uploads += ElapsedSeconds(f.rangeStart[r], f.rangeUploaded[r]);
     const double span = ElapsedSeconds(f.start, f.end);
@@ -1190,8 +1191,6 @@ private:
     for (std::size_t p = 0; p < parts; ++p)
       sampling +=
         ElapsedSeconds(f.PartEvent(p, BatchFlight::SamplingStart), f.PartEvent(p, BatchFlight::SamplingEnd));
-    if (f.checks)
-      folds = f.foldSeconds;
     phases.staging += staging;
     phases.uploads += uploads;
     phases.foldChecks += folds;
@@ -1344,11 +1343,10 @@ private:
       f.chunkCapacity.resize(p + 1, 0);
   }
 
-  /** On the texture path, the sampling set-up of part `p`. */
+  /** On the texture path, the sampling set-up of part `p` (reserved). */
   void
   PreparePart(BatchFlight & f, std::size_t p)
   {
-    ReservePart(f, p);
     f.hostChunks[p] = 0; // stays 0 for a part without items
     if (!UsesTexturePath())
       return;
@@ -1518,6 +1516,7 @@ private:
     f.candidateBounds.assign({ 0, 0 });
     f.itemBounds.assign({ 0, items });
     f.sampledParts = 0;
+    ReservePart(f, 0);
     PreparePart(f, 0);
     QueueSampling(f);
     WaitFor(f.copiedEvents[0]->Get(), "evaluating tetrahedra");
