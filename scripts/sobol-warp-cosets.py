@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""Finds the index subspace W whose cosets the texture sampling kernel's lanes
-take in a whole chunk of 512 samples (CosetBasis in src/cuda/TextureKernels.cu).
+"""Finds the index subspaces W whose cosets the texture sampling kernel's lanes
+take in whole chunks of 512 samples (CosetBases in src/core/SampleCosets.cxx).
 
 A tetrahedron's sample k is the scrambled Sobol point of Gray code k ^ (k >> 1);
 both the Gray code and the direction numbers are linear over XOR, so samples
@@ -12,9 +12,16 @@ one whose cosets of 32 samples touch the fewest texture-sector-sized blocks
 (4 x 4 x 2 texels) with their trilinear footprints. It prints those counts for
 consecutive lanes and for the chosen cosets.
 
-Usage: scripts/sobol-warp-cosets.py  (needs numpy; a few seconds)
+For larger aligned blocks of 2^B samples (--bits B, 10 to 14), W is the set of
+offsets that keep the top a_d bits of every Sobol coordinate d (an elementary
+box; the bits' total is B - 5): it tries every shape whose a_d lie within 2 of
+each other, in a tetrahedron of 1.5 x 2^B voxels, and prints the best three
+with the counts for consecutive lanes and for the 2^9 W in each aligned 512.
+
+Usage: scripts/sobol-warp-cosets.py [--bits B]  (needs numpy; seconds to a minute)
 """
 import itertools
+import sys
 
 import numpy as np
 
@@ -88,6 +95,88 @@ def sectors(rows, p, shape=(4, 4, 2)):
     return float(np.mean(counts))
 
 
+def state_of(k):
+    """The unshifted Sobol state of index k (Gray-code order)."""
+    gray, state = k ^ (k >> 1), [0, 0, 0, 0]
+    for j in range(32):
+        if (gray >> j) & 1:
+            for d in range(4):
+                state[d] ^= V[d][j]
+    return state
+
+
+def null_space(rows, bits):
+    """A basis of {x < 2^bits : every row & x has even parity} (over GF(2))."""
+    pivots, reduced = [], []
+    for r in rows:
+        for p, q in zip(pivots, reduced):
+            if (r >> p) & 1:
+                r ^= q
+        if r:
+            p = r.bit_length() - 1
+            reduced = [q ^ r if (q >> p) & 1 else q for q in reduced] + [r]
+            pivots.append(p)
+    basis = []
+    for f in (i for i in range(bits) if i not in pivots):
+        x = 1 << f
+        for p, q in zip(pivots, reduced):
+            if (q >> f) & 1:
+                x |= 1 << p
+        basis.append(x)
+    return basis
+
+
+def box_basis(shape, bits):
+    """W for an elementary box: offsets that keep the top shape[d] bits of
+    coordinate d."""
+    columns = [state_of(1 << i) for i in range(bits)]
+    rows = [sum(((columns[i][d] >> (31 - r)) & 1) << i for i in range(bits)) for d in range(4) for r in range(shape[d])]
+    return null_space(rows, bits)
+
+
+def block_points(bits, first, shift, corners):
+    """Sample positions (voxels) of indices first .. first + 2^bits - 1."""
+    k = np.arange(first, first + (1 << bits), dtype=np.uint64)
+    gray = k ^ (k >> np.uint64(1))
+    state = np.zeros((4, len(k)), np.uint64)
+    for j in range(32):
+        bit = ((gray >> np.uint64(j)) & np.uint64(1)).astype(bool)
+        for d in range(4):
+            state[d][bit] ^= np.uint64(V[d][j])
+    e = np.stack([-np.log(((state[d] ^ np.uint64(shift[d])).astype(float) + 0.5) / 2**32) for d in range(4)], 1)
+    return (e / e.sum(1, keepdims=True)) @ corners
+
+
+def block_cosets(basis, bits):
+    members, seen, rows = np.array(span(basis)), np.zeros(1 << bits, bool), []
+    for k in range(1 << bits):
+        if not seen[k]:
+            row = k ^ members
+            seen[row] = True
+            rows.append(row)
+    return rows
+
+
+def larger_blocks(bits):
+    rng = np.random.default_rng(1)
+    corners = CORNERS * ((1.5 * (1 << bits) / 984) ** (1 / 3))
+    n = 1 << bits
+    blocks = [block_points(bits, n * (3 + t), [int(x) for x in rng.integers(0, 2**32, 4)], corners) for t in range(2)]
+    consecutive = [np.arange(32 * r, 32 * r + 32) for r in range(n // 32)]
+    small = [r + BLOCK * s for s in range(n // BLOCK) for r in block_cosets([216, 392, 464, 332, 432], BITS)]
+    print(f"2^{bits}: consecutive lanes {np.mean([sectors(consecutive, p) for p in blocks]):.1f}, "
+          f"2^9 cosets {np.mean([sectors(small, p) for p in blocks]):.1f} blocks per row")
+    found = []
+    for shape in itertools.product(range(bits - 4), repeat=4):
+        if sum(shape) != bits - 5 or max(shape) - min(shape) > 2:
+            continue
+        basis = box_basis(shape, bits)
+        if len(basis) == 5:
+            found.append((np.mean([sectors(block_cosets(basis, bits), p) for p in blocks]), shape, basis))
+    for score, shape, basis in sorted(found)[:3]:
+        print(f"  top bits {shape}: W = {basis}: {score:.1f} blocks per row")
+
+
 def main():
     rng = np.random.default_rng(1)
     blocks = [points(BLOCK * (5 + t), [int(x) for x in rng.integers(0, 2**32, 4)]) for t in range(4)]
@@ -112,4 +201,7 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    if len(sys.argv) == 3 and sys.argv[1] == "--bits":
+        larger_blocks(int(sys.argv[2]))
+    else:
+        main()

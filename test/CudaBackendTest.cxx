@@ -448,7 +448,8 @@ TEST(CudaEvaluationBackend, PartsWithMoreChunksThanGuessedAreSampledAgain)
 }
 
 // Tetrahedra of more than 512 samples are sampled in whole chunks whose
-// lanes take the points in another order (cosets of an index subspace). On
+// lanes take the points in another order (cosets of an index subspace, one
+// for each size of aligned block: morea/SampleCosets.h). On
 // voxel noise, every tetrahedron's sum must match the CPU's points; as a
 // check that the tolerance can fail, another point set (the same mesh moved
 // by 1e-9 mm, so other seeds) must differ from the CPU's by more than it.
@@ -460,38 +461,52 @@ TEST(CudaEvaluationBackend, TextureWholeChunksSampleTheCpuPoints)
   for (ChannelVolume * image : { &problem.data.fixed, &problem.data.moving })
     for (std::size_t v = 0; v < image->data.size(); v += 2)
       image->data[v] = static_cast<float>(0.2 + 0.8 * noise.Uniform());
-  problem.data.samplingRate = 16.0;
   GomeaOptions options = problem.Options(9);
   options.populationSize = 2;
   const auto population = problem.InitialPopulation(options);
   DualMesh   moved = population[1];
   for (Vec3 & p : moved.source)
     p[0] += 1e-9;
-  auto cpu = CreateCpuEvaluationBackend(*problem.evaluator, 2);
-  auto texture = CreateCudaEvaluationBackend(*problem.evaluator, 2, CudaInterpolation::Texture);
-  std::vector<TetrahedronValues> a, b, c;
-  cpu->EvaluateSolutions({ &population[1] }, { &a });
-  texture->EvaluateSolutions({ &population[1] }, { &b });
-  cpu->EvaluateSolutions({ &moved }, { &c });
-  ASSERT_EQ(a.size(), b.size());
-  std::size_t wholeChunks = 0, otherPointsDiffer = 0;
-  double      worst = 0.0;
-  for (std::size_t t = 0; t < a.size(); ++t)
+  // 16 samples per voxel: many tetrahedra with whole chunks; 128: blocks of
+  // 2^11 samples or more, each with its own cosets.
+  for (const double rate : { 16.0, 128.0 })
   {
-    EXPECT_EQ(a[t].samples, b[t].samples);
-    if (a[t].samples < 1100.0) // both directions: at least one whole chunk
-      continue;
-    ++wholeChunks;
-    const double relative = std::abs(a[t].intensity - b[t].intensity) / a[t].intensity;
-    worst = std::max(worst, relative);
-    EXPECT_LT(relative, 3e-3) << "tetrahedron " << t << ": cpu " << a[t].intensity << " cuda " << b[t].intensity;
-    if (std::abs(a[t].intensity - c[t].intensity) / a[t].intensity > 3e-3)
-      ++otherPointsDiffer;
+    problem.data.samplingRate = rate;
+    auto cpu = CreateCpuEvaluationBackend(*problem.evaluator, 2);
+    auto texture = CreateCudaEvaluationBackend(*problem.evaluator, 2, CudaInterpolation::Texture);
+    std::vector<TetrahedronValues> a, b, c;
+    cpu->EvaluateSolutions({ &population[1] }, { &a });
+    texture->EvaluateSolutions({ &population[1] }, { &b });
+    cpu->EvaluateSolutions({ &moved }, { &c });
+    ASSERT_EQ(a.size(), b.size());
+    std::size_t wholeChunks = 0, largerBlocks = 0, otherPointsDiffer = 0;
+    double      worst = 0.0;
+    for (std::size_t t = 0; t < a.size(); ++t)
+    {
+      EXPECT_EQ(a[t].samples, b[t].samples);
+      if (a[t].samples < 1100.0) // both directions: at least one whole chunk
+        continue;
+      ++wholeChunks;
+      if (a[t].samples >= 4096.0) // a direction with a block of 2^11 or more
+        ++largerBlocks;
+      const double relative = std::abs(a[t].intensity - b[t].intensity) / a[t].intensity;
+      worst = std::max(worst, relative);
+      EXPECT_LT(relative, 3e-3) << "rate " << rate << ", tetrahedron " << t << ": cpu " << a[t].intensity << " cuda "
+                                << b[t].intensity;
+      if (std::abs(a[t].intensity - c[t].intensity) / a[t].intensity > 3e-3)
+        ++otherPointsDiffer;
+    }
+    std::cout << rate << " samples per voxel: " << wholeChunks << " tetrahedra with whole chunks (" << largerBlocks
+              << " with blocks of 2^11 or more), largest relative difference " << worst << ", " << otherPointsDiffer
+              << " differ with other points\n";
+    if (rate == 16.0)
+    {
+      EXPECT_GE(wholeChunks, 50u);
+      EXPECT_GE(otherPointsDiffer, wholeChunks * 3 / 4);
+    }
+    else
+      EXPECT_GE(largerBlocks, 50u);
   }
-  std::cout << wholeChunks << " tetrahedra with whole chunks, largest relative difference " << worst << ", "
-            << otherPointsDiffer << " differ with other points\n";
-  EXPECT_GE(wholeChunks, 50u);
-  EXPECT_GE(otherPointsDiffer, wholeChunks * 3 / 4);
 }
 
 TEST(EvaluationBackendSelection, NamesAndDeviceAbsence)

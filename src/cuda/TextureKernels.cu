@@ -15,12 +15,12 @@
 #include "DeviceMemory.h"
 #include "TetrahedronDevice.cuh"
 
+#include "morea/SampleCosets.h"
+
 #include <cub/device/device_radix_sort.cuh>
 #include <cub/device/device_scan.cuh>
 
-#include <array>
 #include <cstdint>
-#include <vector>
 
 namespace morea::cuda
 {
@@ -34,25 +34,22 @@ __constant__ std::uint32_t c_SobolDirections[4 * 32];
  *  per chunk instead of twenty masked XORs. */
 __device__ uint4 g_LaneSobol[32];
 
-/** Lanes of a whole chunk of 512 samples take spatially close points.
- *  Points whose indices in an aligned block of 2^9 differ by an element of
- *  a 5-dimensional subspace W of GF(2)^9 (the Gray code and the direction
- *  numbers are linear over XOR) share a small part of the tetrahedron for
- *  the W below, so each row of a whole chunk is one coset of W: its lanes'
- *  texel footprints share about half as many texture sectors as 32
- *  consecutive samples (scripts/sobol-warp-cosets.py). The sixteen rows
- *  take the cosets in Gray-code order over a complement of W; the chunk's
- *  points are the same, only the order in which they are added differs.
- *  Whole chunks hold about three quarters of the paper configuration's
- *  samples; on an H100 the kernels served 9.00e10 samples per second
- *  against 8.46e10 with consecutive lanes. */
-constexpr std::uint32_t CosetRows = 16;
-constexpr std::uint32_t CosetBasis[5] = { 216, 392, 464, 332, 432 };
-/** Per lane its element of W as a Sobol state part (without the shift). */
-__device__ uint4 g_CosetLaneSobol[32];
-/** The state part of the complement's basis vector that row r + 1 adds,
- *  indexed by ctz(r + 1). */
-__constant__ uint4 c_CosetRowSteps[4];
+/** Lanes of a whole chunk of 512 samples take spatially close points: each
+ *  row of 32 is one coset of an index subspace W chosen for the aligned
+ *  block of 2^9 to 2^14 samples the chunk lies in (morea/SampleCosets.h,
+ *  which also says which block and cosets a chunk takes). The points are the
+ *  CPU's; only the order in which they are added differs. On an H100, one
+ *  W for blocks of 2^9 served 9.00e10 samples per second against 8.46e10
+ *  with consecutive lanes; in larger tetrahedra its rows spread further, and
+ *  a W for each block size served 9.01e10 against 8.92e10 (early
+ *  generations, cuda/early-h100-block-cosets.txt). */
+constexpr std::uint32_t CosetRows = CosetRowsPerChunk;
+/** Per block size and lane its element of W as a Sobol state part (without
+ *  the shift). */
+__device__ uint4 g_CosetLaneSobol[CosetLevels][32];
+/** Per block size the state parts of the complement's basis vectors: the
+ *  row after coset r adds the one indexed by ctz(r + 1). */
+__constant__ uint4 c_CosetRowSteps[CosetLevels][MaxCosetRowBits];
 
 /** One direction of one tetrahedron, ready to sample. */
 struct alignas(16) SampleTask
@@ -420,11 +417,12 @@ SampleRows(const SamplingConstants & k, const float4 * corners, std::uint32_t j,
   }
 }
 
-/** Samples a whole chunk of 512 by cosets (CosetBasis); `state`: the Sobol
- *  state of the chunk's first coset for this lane. */
+/** Samples a whole chunk of 512 by cosets (morea/SampleCosets.h) of a block
+ *  of 2^(MinCosetBits + level); `state`: the Sobol state of the chunk's
+ *  first coset for this lane. */
 template <int Direction>
 __device__ void
-SampleCosets(const SamplingConstants & k, const float4 * corners, bool near, std::uint32_t state[4],
+SampleCosetRows(const SamplingConstants & k, const float4 * corners, bool near, int level, std::uint32_t state[4],
              float & intensity, float & guidance)
 {
   for (std::uint32_t row = 0;;)
@@ -432,7 +430,7 @@ SampleCosets(const SamplingConstants & k, const float4 * corners, bool near, std
     SamplePoint<Direction>(k, corners, near, state, intensity, guidance);
     if (++row == CosetRows)
       break;
-    const uint4 step = c_CosetRowSteps[__ffs(static_cast<int>(row)) - 1];
+    const uint4 step = c_CosetRowSteps[level][__ffs(static_cast<int>(row)) - 1];
     state[0] ^= step.x;
     state[1] ^= step.y;
     state[2] ^= step.z;
@@ -500,17 +498,42 @@ LoadChunk(const SampleTask * __restrict__ tasks, const std::uint32_t * __restric
  *    arbitrary high bits, so those points are no closer together. A
  *    diagnostic build whose 32 lanes differed only in dimension 1 (wrong
  *    values) reached 1.13e11: close points pay. Offsets chosen from the
- *    whole block, not single bits, find them (CosetBasis). */
+ *    whole block, not single bits, find them (morea/SampleCosets.h). */
 __device__ void
 SampleChunk(const SamplingConstants & k, const ChunkHeader & h, std::size_t chunk, int lane, const float4 * corners,
             double2 * chunkSums)
 {
-  const int     direction = static_cast<int>(h.task & 1u);
-  const std::uint32_t j = h.local * k.chunkIterations;
-  const bool    cosets = k.chunkIterations == CosetRows && 32 * (j + CosetRows) <= h.n; // uniform
-  const uint4   lanePart = cosets ? g_CosetLaneSobol[lane] : g_LaneSobol[lane];
-  std::uint32_t state[4] = { h.shift.x ^ lanePart.x, h.shift.y ^ lanePart.y, h.shift.z ^ lanePart.z,
-                             h.shift.w ^ lanePart.w };
+  const int           direction = static_cast<int>(h.task & 1u);
+  std::uint32_t       j = h.local * k.chunkIterations;
+  const bool          cosets = k.chunkIterations == CosetRows && 32 * (j + CosetRows) <= h.n; // uniform
+  int                 level = 0;
+  uint4               lanePart;
+  std::uint32_t       state[4] = { h.shift.x, h.shift.y, h.shift.z, h.shift.w };
+  if (cosets)
+  {
+    // The block's first index, the chunk's first coset in it (Gray-code
+    // order over the complement), the lane's element of W.
+    const CosetBlock block = WholeChunkBlock(h.n / CosetChunkSamples, h.local);
+    level = block.bits - MinCosetBits;
+    j = block.firstChunk * CosetRows;
+    const std::uint32_t coset = CosetRows * (h.local - block.firstChunk);
+    for (std::uint32_t gray = coset ^ (coset >> 1), b = 0; gray; gray >>= 1, ++b) // warp-uniform loop
+      if (gray & 1u)
+      {
+        const uint4 step = c_CosetRowSteps[level][b];
+        state[0] ^= step.x;
+        state[1] ^= step.y;
+        state[2] ^= step.z;
+        state[3] ^= step.w;
+      }
+    lanePart = g_CosetLaneSobol[level][lane];
+  }
+  else
+    lanePart = g_LaneSobol[lane];
+  state[0] ^= lanePart.x;
+  state[1] ^= lanePart.y;
+  state[2] ^= lanePart.z;
+  state[3] ^= lanePart.w;
   {
     std::uint32_t rowPart[4];
     SobolWarpPart(j, c_SobolDirections, rowPart);
@@ -523,9 +546,9 @@ SampleChunk(const SamplingConstants & k, const ChunkHeader & h, std::size_t chun
   if (cosets) // both conditions are the same for the whole warp
   {
     if (direction == 0)
-      SampleCosets<0>(k, corners, h.near, state, intensity, guidance);
+      SampleCosetRows<0>(k, corners, h.near, level, state, intensity, guidance);
     else
-      SampleCosets<1>(k, corners, h.near, state, intensity, guidance);
+      SampleCosetRows<1>(k, corners, h.near, level, state, intensity, guidance);
   }
   else if (direction == 0)
     SampleRows<0>(k, corners, j, h.n, h.near, lane, state, intensity, guidance);
@@ -664,11 +687,12 @@ UploadTextureSobolDirections(const std::uint32_t * directions)
 {
   Check(cudaMemcpyToSymbol(c_SobolDirections, directions, sizeof(std::uint32_t) * 4 * 32),
         "copying the Sobol direction numbers");
-  // The state part of an index offset x < 2^9: its Gray code's directions.
+  // The state part of an index offset x within a block: its Gray code's
+  // directions.
   const auto part = [directions](std::uint32_t x) {
     const std::uint32_t gray = x ^ (x >> 1);
     uint4               p = make_uint4(0, 0, 0, 0);
-    for (int b = 0; b < 9; ++b)
+    for (int b = 0; b < 32; ++b)
       if ((gray >> b) & 1u)
       {
         p.x ^= directions[0 * 32 + b];
@@ -678,43 +702,20 @@ UploadTextureSobolDirections(const std::uint32_t * directions)
       }
     return p;
   };
-  uint4 lanes[32], cosetLanes[32];
+  uint4 lanes[32];
   for (std::uint32_t lane = 0; lane < 32; ++lane)
-  {
     lanes[lane] = part(lane);
-    std::uint32_t x = 0;
-    for (int b = 0; b < 5; ++b)
-      if ((lane >> b) & 1u)
-        x ^= CosetBasis[b];
-    cosetLanes[lane] = part(x);
-  }
   Check(cudaMemcpyToSymbol(g_LaneSobol, lanes, sizeof(lanes)), "copying the lanes' Sobol parts");
 
-  // W's basis, then a complement from unit vectors: each vector added must
-  // double the set of indices spanned, up to all 512.
-  std::array<bool, 512>      spanned{};
-  std::vector<std::uint32_t> members{ 0 };
-  spanned[0] = true;
-  const auto add = [&](std::uint32_t v) {
-    if (spanned[v])
-      return false;
-    for (std::size_t i = 0, size = members.size(); i < size; ++i)
-    {
-      members.push_back(members[i] ^ v);
-      spanned[members.back()] = true;
-    }
-    return true;
-  };
-  bool independent = true;
-  for (std::uint32_t v : CosetBasis)
-    independent = add(v) && independent;
-  uint4 rowSteps[4];
-  int   steps = 0;
-  for (std::uint32_t b = 0; b < 9 && steps < 4; ++b)
-    if (add(1u << b))
-      rowSteps[steps++] = part(1u << b);
-  if (!independent || steps != 4)
-    throw Error("CUDA backend: the Sobol coset basis does not span the chunk's indices");
+  const SampleCosetLayout & layout = SampleCosets();
+  uint4                     cosetLanes[CosetLevels][32], rowSteps[CosetLevels][MaxCosetRowBits] = {};
+  for (int level = 0; level < CosetLevels; ++level)
+  {
+    for (int lane = 0; lane < 32; ++lane)
+      cosetLanes[level][lane] = part(layout.laneOffsets[level][lane]);
+    for (int b = 0; b < MinCosetBits + level - 5; ++b)
+      rowSteps[level][b] = part(layout.rowOffsets[level][b]);
+  }
   Check(cudaMemcpyToSymbol(g_CosetLaneSobol, cosetLanes, sizeof(cosetLanes)), "copying the lanes' coset parts");
   Check(cudaMemcpyToSymbol(c_CosetRowSteps, rowSteps, sizeof(rowSteps)), "copying the cosets' row steps");
 }
