@@ -3,6 +3,7 @@
 // exactly, and the optimiser makes progress.
 #include "OptimiserTestProblem.h"
 
+#include "morea/CheckpointWriter.h"
 #include "morea/Error.h"
 
 #include <gtest/gtest.h>
@@ -350,8 +351,17 @@ TEST(MoRvGomea, ResumedRunEndsWithTheSameFront)
     first.Initialize(problem.InitialPopulation(options));
     for (int g = 0; g < 5; ++g) // across the steering start and a full re-evaluation
       first.RunGeneration();
-    first.SaveCheckpoint(path);
+    // Written behind the next generation, as `morea register` writes it.
+    CheckpointWriter writer;
+    writer.Write(first.CheckpointBytes(), path);
+    first.SaveCheckpoint(path + ".direct");
     first.RunGeneration(); // work after the checkpoint is lost with the "killed" run
+    writer.Wait();
+    std::ifstream a(path, std::ios::binary), b(path + ".direct", std::ios::binary);
+    const std::string behind((std::istreambuf_iterator<char>(a)), std::istreambuf_iterator<char>());
+    const std::string direct((std::istreambuf_iterator<char>(b)), std::istreambuf_iterator<char>());
+    EXPECT_GT(behind.size(), 1000u);
+    EXPECT_EQ(behind, direct) << "the same state, written behind or at once";
   }
   MoRvGomea resumed(problem.base, problem.topology, problem.parallel, *problem.constraint, *backend, options);
   resumed.LoadCheckpoint(path);

@@ -186,6 +186,9 @@ public:
   Save(std::ostream & out) const;
   void
   Load(std::istream & in);
+  /** Save's bytes, in memory (for a CheckpointWriter). */
+  std::string
+  CheckpointBytes() const;
   /** Atomic: written to a temporary name, then renamed. */
   void
   SaveCheckpoint(const std::string & path) const;

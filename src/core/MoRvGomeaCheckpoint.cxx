@@ -4,6 +4,7 @@
 // and the generation counter. The generator needs no state: generation g
 // draws from (seed, g). Per-tetrahedron values are recomputed on load; the
 // evaluation is deterministic, so they come back bit for bit.
+#include "morea/CheckpointWriter.h"
 #include "morea/Error.h"
 #include "morea/MoRvGomea.h"
 
@@ -14,6 +15,8 @@
 #include <istream>
 #include <limits>
 #include <ostream>
+#include <streambuf>
+#include <string>
 
 namespace morea
 {
@@ -275,35 +278,49 @@ MoRvGomea::Load(std::istream & in)
   m_SteeringLimit = std::numeric_limits<double>::infinity();
 }
 
+std::string
+MoRvGomea::CheckpointBytes() const
+{
+  // Appends straight to the string (an ostringstream would copy it once more).
+  class StringSink : public std::streambuf
+  {
+  public:
+    explicit StringSink(std::string & s)
+      : m_String(s)
+    {}
+
+  protected:
+    std::streamsize
+    xsputn(const char * p, std::streamsize n) override
+    {
+      m_String.append(p, static_cast<std::size_t>(n));
+      return n;
+    }
+    int_type
+    overflow(int_type c) override
+    {
+      if (!traits_type::eq_int_type(c, traits_type::eof()))
+        m_String.push_back(traits_type::to_char_type(c));
+      return traits_type::not_eof(c);
+    }
+
+  private:
+    std::string & m_String;
+  };
+  std::string bytes;
+  // Solutions dominate the size: the population's and the archive's points.
+  const std::size_t solutions = m_Population.size() + m_Archive->Size();
+  bytes.reserve(solutions * (2 * m_Topology.NumberOfPoints() * sizeof(Vec3) + 128) + (1u << 20));
+  StringSink   sink(bytes);
+  std::ostream out(&sink);
+  Save(out);
+  return bytes;
+}
+
 void
 MoRvGomea::SaveCheckpoint(const std::string & path) const
 {
-  const std::string temporary = path + ".partial";
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    if (!out)
-      throw Error("checkpoint: cannot write " + temporary);
-    try
-    {
-      Save(out);
-      out.close();
-      if (!out)
-        throw Error("checkpoint: writing " + temporary + " failed");
-    }
-    catch (...)
-    {
-      out.close();
-      std::remove(temporary.c_str());
-      throw;
-    }
-  }
-  std::error_code ec;
-  std::filesystem::rename(temporary, path, ec);
-  if (ec)
-  {
-    std::remove(temporary.c_str());
-    throw Error("checkpoint: cannot rename " + temporary + " to " + path + ": " + ec.message());
-  }
+  WriteFileAtomically(path, CheckpointBytes());
 }
 
 void

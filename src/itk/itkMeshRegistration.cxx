@@ -1,6 +1,7 @@
 #include "itkMeshRegistration.h"
 
 #include "itkObjectiveData.h"
+#include "morea/CheckpointWriter.h"
 #include "morea/EvaluationBackend.h"
 #include "morea/FoldConstraint.h"
 #include "morea/InitialPopulation.h"
@@ -47,16 +48,18 @@ RegisterMeshes(const RegistrationProblem & problem, const ::morea::ParameterSet 
     optimiser.Initialize(::morea::GenerateInitialPopulation(
       model.base, constraint, gomea.populationSize, gomea.seed,
       ::morea::InitialPopulationOptions::FromParameters(parameters)));
+  ::morea::CheckpointWriter checkpoints; // files written while the next generations run
   while (!optimiser.Finished())
   {
     optimiser.RunGeneration();
     const bool last = optimiser.Finished();
     if (!options.checkpointPath.empty() &&
         (last || (options.checkpointInterval > 0 && optimiser.Generation() % options.checkpointInterval == 0)))
-      optimiser.SaveCheckpoint(options.checkpointPath);
+      checkpoints.Write(optimiser.CheckpointBytes(), options.checkpointPath);
     if (options.onGeneration)
       options.onGeneration(optimiser.History().back(), gomea.generations);
   }
+  checkpoints.Wait();
   result.secondsOptimisation = std::chrono::duration<double>(Clock::now() - start).count();
   result.history = optimiser.History();
   for (const auto & e : optimiser.Archive().Entries())
