@@ -423,7 +423,7 @@ SampleRows(const SamplingConstants & k, const float4 * corners, std::uint32_t j,
 template <int Direction>
 __device__ void
 SampleCosetRows(const SamplingConstants & k, const float4 * corners, bool near, int level, std::uint32_t state[4],
-             float & intensity, float & guidance)
+                float & intensity, float & guidance)
 {
   for (std::uint32_t row = 0;;)
   {
