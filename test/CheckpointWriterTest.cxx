@@ -34,9 +34,13 @@ TEST(CheckpointWriter, WritesReplaceTheFileWhole)
   writer.Wait();
   EXPECT_EQ(ReadAll(path), second);
   writer.Write(first, path.string());
-  writer.Wait();
+  // The buffer comes back empty with its room, once written.
+  std::string buffer = writer.TakeBuffer();
+  EXPECT_TRUE(buffer.empty());
+  EXPECT_GE(buffer.capacity(), first.size());
   EXPECT_EQ(ReadAll(path), first);
   EXPECT_FALSE(std::filesystem::exists(path.string() + ".partial"));
+  EXPECT_EQ(writer.TakeBuffer().capacity(), std::string().capacity()); // handed back once
   writer.Wait(); // nothing in progress
   std::filesystem::remove_all(dir);
 }

@@ -353,7 +353,9 @@ TEST(MoRvGomea, ResumedRunEndsWithTheSameFront)
       first.RunGeneration();
     // Written behind the next generation, as `morea register` writes it.
     CheckpointWriter writer;
-    writer.Write(first.CheckpointBytes(), path);
+    std::string      reused(123, 'x'); // filled afresh, whatever it held
+    first.CheckpointBytes(reused);
+    writer.Write(std::move(reused), path);
     first.SaveCheckpoint(path + ".direct");
     first.RunGeneration(); // work after the checkpoint is lost with the "killed" run
     writer.Wait();

@@ -36,6 +36,13 @@ public:
   void
   Write(std::string bytes, std::string path);
 
+  /** Waits for the write in progress (throwing its error) and hands back
+   *  its buffer, empty but with its room kept (filling 50 MB took 36 ms in
+   *  a fresh buffer, mostly page faults, and 8 ms in a reused one, on a
+   *  2-core development machine). */
+  std::string
+  TakeBuffer();
+
   /** Waits for the write in progress; throws its error. */
   void
   Wait();
@@ -43,6 +50,7 @@ public:
 private:
   std::thread        m_Thread;
   std::exception_ptr m_Error;
+  std::string        m_Spare; ///< the last write's buffer (set by its thread)
 };
 } // namespace morea
 

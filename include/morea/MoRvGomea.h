@@ -186,9 +186,12 @@ public:
   Save(std::ostream & out) const;
   void
   Load(std::istream & in);
-  /** Save's bytes, in memory (for a CheckpointWriter). */
+  /** Save's bytes, in memory (for a CheckpointWriter); the second form
+   *  fills `bytes` afresh, keeping its room. */
   std::string
   CheckpointBytes() const;
+  void
+  CheckpointBytes(std::string & bytes) const;
   /** Atomic: written to a temporary name, then renamed. */
   void
   SaveCheckpoint(const std::string & path) const;

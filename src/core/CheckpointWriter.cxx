@@ -45,7 +45,7 @@ void
 CheckpointWriter::Write(std::string bytes, std::string path)
 {
   Wait();
-  m_Thread = std::thread([this, bytes = std::move(bytes), path = std::move(path)] {
+  m_Thread = std::thread([this, bytes = std::move(bytes), path = std::move(path)]() mutable {
     try
     {
       WriteFileAtomically(path, bytes);
@@ -54,7 +54,18 @@ CheckpointWriter::Write(std::string bytes, std::string path)
     {
       m_Error = std::current_exception(); // read after join
     }
+    m_Spare = std::move(bytes); // likewise
   });
+}
+
+std::string
+CheckpointWriter::TakeBuffer()
+{
+  Wait();
+  std::string buffer = std::move(m_Spare);
+  m_Spare = std::string();
+  buffer.clear();
+  return buffer;
 }
 
 void

@@ -281,6 +281,14 @@ MoRvGomea::Load(std::istream & in)
 std::string
 MoRvGomea::CheckpointBytes() const
 {
+  std::string bytes;
+  CheckpointBytes(bytes);
+  return bytes;
+}
+
+void
+MoRvGomea::CheckpointBytes(std::string & bytes) const
+{
   // Appends straight to the string (an ostringstream would copy it once more).
   class StringSink : public std::streambuf
   {
@@ -307,14 +315,13 @@ MoRvGomea::CheckpointBytes() const
   private:
     std::string & m_String;
   };
-  std::string bytes;
+  bytes.clear();
   // Solutions dominate the size: the population's and the archive's points.
   const std::size_t solutions = m_Population.size() + m_Archive->Size();
   bytes.reserve(solutions * (2 * m_Topology.NumberOfPoints() * sizeof(Vec3) + 128) + (1u << 20));
   StringSink   sink(bytes);
   std::ostream out(&sink);
   Save(out);
-  return bytes;
 }
 
 void

@@ -11,6 +11,8 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <string>
+#include <utility>
 #include <thread>
 
 namespace itk
@@ -55,7 +57,11 @@ RegisterMeshes(const RegistrationProblem & problem, const ::morea::ParameterSet 
     const bool last = optimiser.Finished();
     if (!options.checkpointPath.empty() &&
         (last || (options.checkpointInterval > 0 && optimiser.Generation() % options.checkpointInterval == 0)))
-      checkpoints.Write(optimiser.CheckpointBytes(), options.checkpointPath);
+    {
+      std::string bytes = checkpoints.TakeBuffer(); // the last checkpoint's room
+      optimiser.CheckpointBytes(bytes);
+      checkpoints.Write(std::move(bytes), options.checkpointPath);
+    }
     if (options.onGeneration)
       options.onGeneration(optimiser.History().back(), gomea.generations);
   }
