@@ -84,9 +84,10 @@ CosetSampleIndex(const SampleCosetLayout & layout, std::uint32_t samples, std::u
                  std::uint32_t lane);
 
 /** The unshifted Sobol state of the samples whose indices differ by `x`
- *  within an aligned block: the XOR of the direction numbers of x's Gray code. */
+ *  within an aligned block: the XOR of the direction numbers of x's Gray code
+ *  (4 dimensions x 32 bits, row-major; by default SobolDirectionNumbers()). */
 std::array<std::uint32_t, 4>
-SobolStateOfOffset(std::uint32_t x);
+SobolStateOfOffset(std::uint32_t x, const std::uint32_t * directions = nullptr);
 } // namespace morea
 
 #endif

@@ -8,9 +8,7 @@
 #include "morea/Error.h"
 #include "morea/MoRvGomea.h"
 
-#include <cstdio>
 #include <cstring>
-#include <filesystem>
 #include <fstream>
 #include <istream>
 #include <limits>

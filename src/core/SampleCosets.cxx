@@ -98,9 +98,10 @@ CosetSampleIndex(const SampleCosetLayout & layout, std::uint32_t samples, std::u
 }
 
 std::array<std::uint32_t, 4>
-SobolStateOfOffset(std::uint32_t x)
+SobolStateOfOffset(std::uint32_t x, const std::uint32_t * directions)
 {
-  const std::uint32_t *        directions = SobolDirectionNumbers();
+  if (directions == nullptr)
+    directions = SobolDirectionNumbers();
   const std::uint32_t          gray = x ^ (x >> 1);
   std::array<std::uint32_t, 4> state{};
   for (int b = 0; b < 32; ++b)

@@ -20,6 +20,7 @@
 #include <cub/device/device_radix_sort.cuh>
 #include <cub/device/device_scan.cuh>
 
+#include <array>
 #include <cstdint>
 
 namespace morea::cuda
@@ -687,20 +688,10 @@ UploadTextureSobolDirections(const std::uint32_t * directions)
 {
   Check(cudaMemcpyToSymbol(c_SobolDirections, directions, sizeof(std::uint32_t) * 4 * 32),
         "copying the Sobol direction numbers");
-  // The state part of an index offset x within a block: its Gray code's
-  // directions.
+  // The state part of an index offset x within a block (SobolStateOfOffset).
   const auto part = [directions](std::uint32_t x) {
-    const std::uint32_t gray = x ^ (x >> 1);
-    uint4               p = make_uint4(0, 0, 0, 0);
-    for (int b = 0; b < 32; ++b)
-      if ((gray >> b) & 1u)
-      {
-        p.x ^= directions[0 * 32 + b];
-        p.y ^= directions[1 * 32 + b];
-        p.z ^= directions[2 * 32 + b];
-        p.w ^= directions[3 * 32 + b];
-      }
-    return p;
+    const std::array<std::uint32_t, 4> p = SobolStateOfOffset(x, directions);
+    return make_uint4(p[0], p[1], p[2], p[3]);
   };
   uint4 lanes[32];
   for (std::uint32_t lane = 0; lane < 32; ++lane)

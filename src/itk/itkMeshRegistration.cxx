@@ -12,8 +12,8 @@
 #include <chrono>
 #include <filesystem>
 #include <string>
-#include <utility>
 #include <thread>
+#include <utility>
 
 namespace itk
 {
