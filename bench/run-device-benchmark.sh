@@ -24,6 +24,9 @@
 #                  names the functions (with the build the bundle was made from).
 #   Whole runs: bench/run-device-benchmark.sh whole OUTDIR SECONDS BACKEND LABEL PROGRAM [OPTIONS]
 #                  registers from scratch with PROGRAM (e.g. /tmp/b/bin/morea-old) and OPTIONS.
+#   Late generations of several builds: bench/run-device-benchmark.sh late-ab OUTDIR SECONDS BACKEND
+#                  GENERATIONS ROUNDS PROGRAM... times GENERATIONS from one common checkpoint
+#                  per program, in turns; one summary line and the device phases each.
 #   Refusal bound: bench/run-device-benchmark.sh bound OUTDIR SECONDS BACKEND GENERATIONS [ROUNDS [PROGRAM...]]
 #                  times late generations with --refusal-bound on and off in turns.
 set -euo pipefail
@@ -224,6 +227,34 @@ EOF2
       --cpu-generations "$generations" --threads 16 --probe 0 --from-checkpoint /tmp/ab/profile/checkpoint.bin \
       -o "$out/profiled.json" "$@" > "$out/profiled.log" 2>&1
     summary "$out/profiled.json" "$backend" profiled
+    ;;
+  late-ab)
+    # Several programs over the same late generations: the bundle's morea
+    # registers for SECONDS, then each PROGRAM times GENERATIONS from that
+    # checkpoint with `morea benchmark`, programs in turns, ROUNDS times
+    # (OUTDIR/NAME-ROUND.json). Programs that decide differently part ways
+    # after the checkpoint, so compare them over few generations.
+    out=${2:?output folder}
+    seconds=${3:?seconds of the start}
+    backend=${4:?backend}
+    generations=${5:?generations}
+    rounds=${6:?rounds}
+    shift 6
+    mkdir -p "$out" /tmp/ab
+    unpack_bundle
+    rm -rf /tmp/ab/late-ab
+    register /tmp/b/bin/morea /tmp/ab/late-ab "$seconds" "$backend" || true
+    tail -n 2 /tmp/ab/late-ab/register.log > "$out/start-tail.log"
+    for round in $(seq "$rounds"); do
+      for program in "$@"; do
+        name=$(basename "$program")
+        "$program" benchmark "${PROBLEM[@]}" --backends "$backend" --generations "$generations" --probe 0 \
+          --from-checkpoint /tmp/ab/late-ab/checkpoint.bin -o "$out/$name-$round.json" > "$out/$name-$round.log" 2>&1 ||
+          { tail -3 "$out/$name-$round.log"; continue; }
+        summary "$out/$name-$round.json" "$backend" "$name"
+        python3 bench/device-phases.py "$out/$name-$round.json" "$backend" 2>/dev/null | sed -n 2p || true
+      done
+    done
     ;;
   bound)
     # The refusal bound on and off over the same late generations: the

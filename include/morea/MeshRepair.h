@@ -36,7 +36,9 @@ struct RepairResult
  *  Each point of a folded tetrahedron draws `samplesPerPoint` Gaussian moves
  *  whose scale is the point's mean distance to the planes of the faces
  *  opposite it (its surrounding polyhedron); the move that lowers the
- *  violation of the point's tetrahedra most is kept. A point whose samples all
+ *  violation of the point's tetrahedra most is kept (trials are ranked by the
+ *  star terms of RepairStar.h: the same violations, rounded otherwise; the
+ *  results before/after are the constraint's own). A point whose samples all
  *  make things worse is left alone; the repair stops when a whole pass moves
  *  nothing, when the mesh is fold-free, or after maxRounds passes. */
 RepairResult

@@ -1,6 +1,7 @@
 #include "morea/MeshRepair.h"
 
 #include "morea/RepairNoise.h"
+#include "morea/RepairStar.h"
 
 #include <algorithm>
 #include <cmath>
@@ -43,18 +44,39 @@ Better(const FoldViolation & a, const FoldViolation & b)
   return a.value < b.value || (a.value <= b.value && a.folded < b.folded);
 }
 
-/** The violation of tetrahedra [first, last) (FoldConstraint::Partial's sum,
- *  in its order), or false as soon as the running value exceeds `bound`:
- *  violations are non-negative, so such a trial cannot be Better. */
+/** The star of point p (RepairStar.h): its tetrahedra in ascending order. */
+void
+GatherStar(std::uint32_t p, const std::vector<Vec3> & points, const FoldConstraint & constraint,
+           std::vector<StarTerm> & star)
+{
+  const MeshTopology & topology = constraint.Topology();
+  star.clear();
+  for (const std::uint32_t * t = topology.TetrahedraOfPointBegin(p); t != topology.TetrahedraOfPointEnd(p); ++t)
+  {
+    const Tetrahedron & tet = topology.Tetrahedra()[*t];
+    const double *      other[3];
+    int                 m = 0, slot = 0;
+    for (int j = 0; j < 4; ++j)
+      if (tet[j] == p)
+        slot = j;
+      else if (m < 3)
+        other[m++] = points[tet[j]].data();
+    star.emplace_back();
+    MakeStarTerm(other, slot, constraint.ReferenceVolumes()[*t], constraint.VolumeFraction(), star.back());
+  }
+}
+
+/** The star's violation with the point at x (sixfold units), or false as
+ *  soon as the running value exceeds `bound`: the terms are non-negative, so
+ *  such a trial cannot be Better. */
 bool
-BoundedViolation(const FoldConstraint & constraint, const std::vector<Vec3> & points, const std::uint32_t * first,
-                 const std::uint32_t * last, double bound, FoldViolation & out)
+BoundedViolation(const std::vector<StarTerm> & star, const double * x, double bound, FoldViolation & out)
 {
   out = FoldViolation{};
-  for (const std::uint32_t * t = first; t != last; ++t)
+  for (const StarTerm & term : star)
   {
     bool folded = false;
-    out.value += constraint.TetrahedronViolation(*t, points, folded);
+    out.value += StarTermViolation(term, x, folded);
     out.folded += folded;
     if (out.value > bound)
       return false;
@@ -108,16 +130,16 @@ RepairPoints(std::vector<Vec3> & points, const std::vector<std::uint32_t> * mova
                                       }),
                        candidates.end());
 
-    bool moved = false;
+    bool                  moved = false;
+    std::vector<StarTerm> star;
     for (std::uint32_t p : candidates)
     {
       const BoundaryPin & pin = base.pins[p];
       if (pin[0] != 0 && pin[1] != 0 && pin[2] != 0)
         continue; // corners never move
-      const std::uint32_t * localBegin = topology.TetrahedraOfPointBegin(p);
-      const std::uint32_t * localEnd = topology.TetrahedraOfPointEnd(p);
-      FoldViolation         current;
-      BoundedViolation(constraint, points, localBegin, localEnd, std::numeric_limits<double>::infinity(), current);
+      GatherStar(p, points, constraint, star);
+      FoldViolation current;
+      BoundedViolation(star, points[p].data(), std::numeric_limits<double>::infinity(), current);
       if (current.Feasible())
         continue; // fixed by an earlier move in this pass
       const double scale = DistanceToSurroundingPolyhedron(p, points, topology);
@@ -130,14 +152,14 @@ RepairPoints(std::vector<Vec3> & points, const std::vector<std::uint32_t> * mova
       {
         double move[3];
         RepairTrialNormals(seed, static_cast<std::uint32_t>(round), p, static_cast<std::uint32_t>(s), move);
-        const Vec3 trial{ { original[0] + scale * move[0], original[1] + scale * move[1],
-                            original[2] + scale * move[2] } };
-        points[p] = ProjectToDomain(trial, pin, base.domain);
+        const Vec3 trial = ProjectToDomain(Vec3{ { original[0] + scale * move[0], original[1] + scale * move[1],
+                                                   original[2] + scale * move[2] } },
+                                           pin, base.domain);
         FoldViolation v;
-        if (BoundedViolation(constraint, points, localBegin, localEnd, best.value, v) && Better(v, best))
+        if (BoundedViolation(star, trial.data(), best.value, v) && Better(v, best))
         {
           best = v;
-          bestPosition = points[p];
+          bestPosition = trial;
         }
       }
       points[p] = bestPosition;

@@ -1,15 +1,16 @@
 // The fold check and the Gaussian repair of partial candidates on the device,
 // mirroring CheckCandidateFolds / RepairPoints (src/core): the same points in
-// the same order, the same moves (RepairNoise.h), the same sums in the same
-// order, rounded as on the host (no fused multiply-adds: a repaired point's
-// bits seed its tetrahedra's samples); only the 64 trials of a point run side
-// by side, one lane each.
+// the same order, the same moves (RepairNoise.h), the same star terms
+// (RepairStar.h) and sums in the same order, rounded as on the host (no fused
+// multiply-adds: a repaired point's bits seed its tetrahedra's samples); only
+// the 64 trials of a point run side by side, one lane each.
 #include "FoldRepairKernels.h"
 
 #include "DeviceMemory.h"
 #include "TetrahedronDevice.cuh"
 
 #include "morea/RepairNoise.h"
+#include "morea/RepairStar.h"
 
 #include <cstdint>
 
@@ -68,17 +69,13 @@ VolumeViolation(const FoldRepairConstants & k, std::uint32_t t, const double * c
   return value;
 }
 
-/** Tetrahedron t's violation with point `trialPoint` (if any) at `trial`. */
+/** Tetrahedron t's violation (the constraint's triple product). */
 __device__ double
-TetrahedronViolation(const FoldRepairConstants & k, const SideView & s, std::uint32_t t, std::uint32_t trialPoint,
-                     const double * trial, bool & folded)
+TetrahedronViolation(const FoldRepairConstants & k, const SideView & s, std::uint32_t t, bool & folded)
 {
   const double * c[4];
   for (int j = 0; j < 4; ++j)
-  {
-    const std::uint32_t v = s.tetrahedra[4 * static_cast<std::size_t>(t) + j];
-    c[j] = v == trialPoint ? trial : s.Point(v);
-  }
+    c[j] = s.Point(s.tetrahedra[4 * static_cast<std::size_t>(t) + j]);
   return VolumeViolation(k, t, c, folded);
 }
 
@@ -95,7 +92,7 @@ FoldedElementPoints(const FoldRepairConstants & k, const SideView & s, const std
   for (std::uint32_t i = lane; i < n; i += 32)
   {
     bool folded = false;
-    TetrahedronViolation(k, s, tets[i], NoPoint, nullptr, folded);
+    TetrahedronViolation(k, s, tets[i], folded);
     if (folded)
       for (int j = 0; j < 4; ++j)
       {
@@ -109,18 +106,38 @@ FoldedElementPoints(const FoldRepairConstants & k, const SideView & s, const std
   return flagged;
 }
 
-/** BoundedViolation: the sum over point p's tetrahedra in ascending order,
- *  false once it exceeds `bound`. */
+/** The star term (RepairStar.h) of tetrahedron t around its corner p. */
+__device__ void
+SideStarTerm(const FoldRepairConstants & k, const SideView & s, std::uint32_t p, std::uint32_t t, StarTerm & term)
+{
+  const double * other[3] = { nullptr, nullptr, nullptr };
+  int            m = 0, slot = 0;
+  for (int j = 0; j < 4; ++j)
+  {
+    const std::uint32_t v = s.tetrahedra[4 * static_cast<std::size_t>(t) + j];
+    if (v == p)
+      slot = j;
+    else if (m < 3)
+      other[m++] = s.Point(v);
+  }
+  MakeStarTerm(other, slot, k.referenceVolumes[t], k.volumeFraction, term);
+}
+
+/** BoundedViolation (MeshRepair.cxx) of point p at `position` for a star too
+ *  large for PointStar: the terms made on the way, in ascending order,
+ *  false once the sum exceeds `bound`. */
 __device__ bool
-PointViolation(const FoldRepairConstants & k, const SideView & s, std::uint32_t p, const double * trial, double bound,
-               double & value, std::uint32_t & folded)
+PointViolation(const FoldRepairConstants & k, const SideView & s, std::uint32_t p, const double * position,
+               double bound, double & value, std::uint32_t & folded)
 {
   value = 0.0;
   folded = 0;
   for (std::uint32_t i = k.pointTetrahedronOffsets[p]; i < k.pointTetrahedronOffsets[p + 1]; ++i)
   {
+    StarTerm term;
+    SideStarTerm(k, s, p, k.pointTetrahedra[i], term);
     bool f = false;
-    value = Add(value, TetrahedronViolation(k, s, k.pointTetrahedra[i], trial ? p : NoPoint, trial, f));
+    value = Add(value, StarTermViolation(term, position, f));
     folded += f;
     if (value > bound)
       return false;
@@ -200,23 +217,17 @@ DistanceToSurroundingPolyhedron(const FoldRepairConstants & k, const SideView & 
 
 /** The tetrahedra around one point as the repair's trials see them: every
  *  corner but the point itself stays where it is while the point's 64 trial
- *  positions are tried, so the lanes gather the corners into shared memory
- *  once (one tetrahedron each) and every trial then reads them with
- *  broadcast loads, instead of following tetrahedron -> point -> element ->
- *  position through global memory for each corner of each trial. The values
- *  and the order of the sums are those of the uncached path. */
+ *  positions are tried, so the lanes make the star's terms (RepairStar.h)
+ *  in shared memory once (one tetrahedron each) and every trial then reads
+ *  them with broadcast loads. The values and the order of the sums are those
+ *  of the uncached path. */
 constexpr std::uint32_t MaxStarTetrahedra = 64;
 
 struct PointStar
 {
-  /** The 3 corners other than the point, in order. Keeping the point's
-   *  own corner out (it is the trial position) took the kernel from 112 to
-   *  96 registers, 4 to 5 resident blocks per SM, and the fold checks and
-   *  repair of the paper configuration's late generations on an H100 from
-   *  0.072 to 0.055 s per generation. */
-  double        corners[MaxStarTetrahedra][9];
-  double        referenceVolume[MaxStarTetrahedra];
-  std::uint8_t  slot[MaxStarTetrahedra]; ///< where the point is among the 4 corners
+  /** A term takes 64 bytes, where the three other corners and the base
+   *  volume took 80 and a trial's triple product 23 operations. */
+  StarTerm      terms[MaxStarTetrahedra];
   std::uint32_t count;
   /** Per tetrahedron a term of a sum that the lanes compute side by side
    *  and then add in order (StarViolationOfAll, StarDistance), and whether
@@ -236,72 +247,22 @@ GatherStar(const FoldRepairConstants & k, const SideView & s, std::uint32_t p, u
   const std::uint32_t count = k.pointTetrahedronOffsets[p + 1] - first;
   __syncwarp(); // no lane still reads the previous point's star
   for (std::uint32_t i = lane; i < count; i += 32)
-  {
-    const std::uint32_t t = k.pointTetrahedra[first + i];
-    std::uint32_t       v[4];
-    int                 slot = -1;
-    for (int j = 0; j < 4; ++j)
-    {
-      v[j] = s.tetrahedra[4 * static_cast<std::size_t>(t) + j];
-      if (v[j] == p)
-        slot = j;
-    }
-    star.slot[i] = static_cast<std::uint8_t>(slot);
-    // The corner at `slot` is never read: StarViolation puts the trial
-    // position there and StarDistance skips it.
-    int m = 0;
-    for (int j = 0; j < 4; ++j)
-      if (j != slot && m < 3)
-      {
-        const double * x = s.Point(v[j]);
-        for (int a = 0; a < 3; ++a)
-          star.corners[i][3 * m + a] = x[a];
-        ++m;
-      }
-    star.referenceVolume[i] = k.referenceVolumes[t];
-  }
+    SideStarTerm(k, s, p, k.pointTetrahedra[first + i], star.terms[i]);
   if (lane == 0)
     star.count = count;
   __syncwarp();
 }
 
-/** The violation of the star's tetrahedron i with the point at `position`. */
-__device__ double
-StarTetrahedronViolation(const FoldRepairConstants & k, const PointStar & star, std::uint32_t i,
-                         const double * position, bool & folded)
-{
-  double    other[9];
-  const int slot = star.slot[i];
-#pragma unroll
-  for (int c = 0; c < 9; ++c)
-    other[c] = star.corners[i][c];
-  // Corner j is stored at j before the point's slot and at j - 1 after it
-  // (the clamps only keep the unrolled indices in range).
-  double corners[12];
-#pragma unroll
-  for (int j = 0; j < 4; ++j)
-#pragma unroll
-    for (int a = 0; a < 3; ++a)
-      corners[3 * j + a] = j == slot ? position[a]
-                           : j < slot ? other[3 * (j < 2 ? j : 2) + a]
-                                      : other[3 * (j > 1 ? j - 1 : 0) + a];
-  double       count = 0.0;
-  const double value = device::CornersVolumeViolation(corners, star.referenceVolume[i], k.volumeFraction, count);
-  folded = count > 0.0;
-  return value;
-}
-
 /** PointViolation from the star, the point at `position`. */
 __device__ bool
-StarViolation(const FoldRepairConstants & k, const PointStar & star, const double * position, double bound,
-              double & value, std::uint32_t & folded)
+StarViolation(const PointStar & star, const double * position, double bound, double & value, std::uint32_t & folded)
 {
   value = 0.0;
   folded = 0;
   for (std::uint32_t i = 0; i < star.count; ++i)
   {
     bool f = false;
-    value = Add(value, StarTetrahedronViolation(k, star, i, position, f));
+    value = Add(value, StarTermViolation(star.terms[i], position, f));
     folded += f;
     if (value > bound)
       return false;
@@ -314,14 +275,13 @@ StarViolation(const FoldRepairConstants & k, const PointStar & star, const doubl
  *  lane going through all the terms itself, this took a sixth of the
  *  repair's time, and StarDistance as much.) */
 __device__ void
-StarViolationOfAll(const FoldRepairConstants & k, PointStar & star, const double * position, unsigned lane,
-                   double & value, std::uint32_t & folded)
+StarViolationOfAll(PointStar & star, const double * position, unsigned lane, double & value, std::uint32_t & folded)
 {
   __syncwarp(); // no lane still reads the terms of the previous sum
   for (std::uint32_t i = lane; i < star.count; i += 32)
   {
     bool f = false;
-    star.term[i] = StarTetrahedronViolation(k, star, i, position, f);
+    star.term[i] = StarTermViolation(star.terms[i], position, f);
     star.counts[i] = f;
   }
   __syncwarp();
@@ -335,17 +295,20 @@ StarViolationOfAll(const FoldRepairConstants & k, PointStar & star, const double
 }
 
 /** DistanceToSurroundingPolyhedron from the star, the faces' distances
- *  computed side by side, added in order by every lane (MeanFaceDistance). */
+ *  computed side by side, added in order by every lane (MeanFaceDistance).
+ *  A term's normal is its face's normal, negated or not, and its volume the
+ *  dot product FacePlaneDistance takes, negated alike: the same bits once
+ *  the sign is dropped. */
 __device__ double
 StarDistance(PointStar & star, const double * x, unsigned lane)
 {
   __syncwarp(); // no lane still reads the terms of the previous sum
   for (std::uint32_t i = lane; i < star.count; i += 32)
   {
-    const double * f[3] = { star.corners[i], star.corners[i] + 3, star.corners[i] + 6 };
-    double         distance = 0.0;
-    star.counts[i] = FacePlaneDistance(f, x, distance);
-    star.term[i] = distance;
+    const double * n = star.terms[i].normal;
+    const double   area2 = sqrt(Add(Add(Mul(n[0], n[0]), Mul(n[1], n[1])), Mul(n[2], n[2])));
+    star.counts[i] = area2 != 0.0;
+    star.term[i] = area2 != 0.0 ? Div(fabs(StarTermVolume(star.terms[i], x)), area2) : 0.0;
   }
   __syncwarp();
   MeanFaceDistance mean;
@@ -412,10 +375,10 @@ RepairSide(const FoldRepairConstants & k, const SideView & s, const std::uint32_
       if (cached)
       {
         GatherStar(k, s, p, lane, star);
-        StarViolationOfAll(k, star, original, lane, currentValue, currentFolded);
+        StarViolationOfAll(star, original, lane, currentValue, currentFolded);
       }
       else
-        PointViolation(k, s, p, nullptr, INFINITY, currentValue, currentFolded);
+        PointViolation(k, s, p, original, INFINITY, currentValue, currentFolded);
       if (currentFolded == 0)
         continue; // fixed by an earlier move in this pass
       const double scale = cached ? StarDistance(star, original, lane) : DistanceToSurroundingPolyhedron(k, s, p);
@@ -443,7 +406,7 @@ RepairSide(const FoldRepairConstants & k, const SideView & s, const std::uint32_
         TrialPosition(k, seed, round, p, trial, original, scale, pin, candidate);
         double        value = 0.0;
         std::uint32_t folded = 0;
-        const bool    within = cached ? StarViolation(k, star, candidate, bound, value, folded)
+        const bool    within = cached ? StarViolation(star, candidate, bound, value, folded)
                                       : PointViolation(k, s, p, candidate, bound, value, folded);
         if (within && (value < bestValue || (value <= bestValue && folded < bestFolded)))
         {
