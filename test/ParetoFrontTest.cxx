@@ -110,11 +110,14 @@ TEST(ParetoFront, RanksUnderConstraintDomination)
 TEST(ParetoFront, RanksAgreeWithDefinitionOnRandomPopulation)
 {
   // Rank r: dominated only by solutions of rank < r, and by one of rank r - 1.
+  // Every other solution on a coarse grid: equal objectives and ties in some.
   morea::RandomGenerator random(7);
   std::vector<Fitness>   population;
   for (int i = 0; i < 300; ++i)
   {
-    Fitness f = Feasible(random.Uniform(), random.Uniform(), random.Uniform());
+    Fitness f = i % 2 ? Feasible(std::floor(random.Uniform(0.0, 4.0)), std::floor(random.Uniform(0.0, 4.0)),
+                                 std::floor(random.Uniform(0.0, 4.0)))
+                      : Feasible(random.Uniform(), random.Uniform(), random.Uniform());
     if (random.Uniform() < 0.2)
     {
       f.feasible = false;

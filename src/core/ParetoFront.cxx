@@ -158,13 +158,36 @@ ConstraintDominates(const Fitness & a, const Fitness & b)
   return Dominates(a.objectives, b.objectives);
 }
 
+namespace
+{
+/** ConstraintDominates both ways in one pass: 1 where a dominates b, -1
+ *  where b dominates a, 0 where neither does. */
+int
+ConstraintOrder(const Fitness & a, const Fitness & b)
+{
+  if (a.feasible != b.feasible)
+    return a.feasible ? 1 : -1;
+  if (!a.feasible)
+    return a.constraint < b.constraint ? 1 : (b.constraint < a.constraint ? -1 : 0);
+  bool worse = false, better = false;
+  for (std::size_t j = 0; j < a.objectives.size(); ++j)
+  {
+    worse |= a.objectives[j] > b.objectives[j];
+    better |= a.objectives[j] < b.objectives[j];
+  }
+  if (better != worse)
+    return better ? 1 : -1;
+  return 0;
+}
+} // namespace
+
 std::vector<std::size_t>
 NonDominatedRanks(const std::vector<Fitness> & population, ThreadPool * pool)
 {
   // Deb's fast non-dominated sort: count who dominates each solution, then peel
   // fronts off by releasing the solutions each front dominates. Each solution
-  // is compared with all others on its own (twice the comparisons of taking
-  // each pair once, but rows side by side on the pool: a paper-scale
+  // is compared with all others on its own (each pair twice, in one pass
+  // for both directions, but rows side by side on the pool: a paper-scale
   // population's sort took about 4 ms of every generation on one thread).
   const std::size_t                       n = population.size();
   std::vector<std::vector<std::uint32_t>> dominatedBy(n); // i -> solutions i dominates
@@ -174,9 +197,10 @@ NonDominatedRanks(const std::vector<Fitness> & population, ThreadPool * pool)
     {
       if (k == i)
         continue;
-      if (ConstraintDominates(population[i], population[k]))
+      const int order = ConstraintOrder(population[i], population[k]);
+      if (order > 0)
         dominatedBy[i].push_back(static_cast<std::uint32_t>(k));
-      else if (ConstraintDominates(population[k], population[i]))
+      else if (order < 0)
         ++dominatorCount[i];
     }
   };
