@@ -27,6 +27,8 @@
 #   Late generations of several builds: bench/run-device-benchmark.sh late-ab OUTDIR SECONDS BACKEND
 #                  GENERATIONS ROUNDS PROGRAM... times GENERATIONS from one common checkpoint
 #                  per program, in turns; one summary line and the device phases each.
+#   The whole command: bench/run-device-benchmark.sh command OUTDIR ROUNDS BACKEND PROGRAM...
+#                  runs a plain `morea register` (reading to outputs) per PROGRAM in turns.
 #   Refusal bound: bench/run-device-benchmark.sh bound OUTDIR SECONDS BACKEND GENERATIONS [ROUNDS [PROGRAM...]]
 #                  times late generations with --refusal-bound on and off in turns.
 set -euo pipefail
@@ -287,12 +289,45 @@ EOF2
       done
     done
     ;;
+  command)
+    # The whole `morea register` command as a user runs it (no resume):
+    # reading, preprocessing, mesh, optimisation, outputs, timed from
+    # outside; per PROGRAM in turns, ROUNDS times. OUTDIR/NAME-ROUND/ gets
+    # the command's log tail, summary.json (its stage times) and front.csv.
+    out=${2:?output folder}
+    rounds=${3:?rounds}
+    backend=${4:?backend}
+    shift 4
+    unpack_bundle
+    for round in $(seq "$rounds"); do
+      for program in "$@"; do
+        name=$(basename "$program")-$round
+        rm -rf "/tmp/command/$name"
+        mkdir -p "$out/$name" "/tmp/command/$name"
+        begin=$(date +%s.%N)
+        status=0
+        "$program" register "${PROBLEM[@]}" --backend "$backend" -o "/tmp/command/$name" \
+          > "/tmp/command/$name.log" 2>&1 || status=$?
+        end=$(date +%s.%N)
+        tail -n 12 "/tmp/command/$name.log" > "$out/$name/register-tail.log"
+        cp "/tmp/command/$name"/summary.json "/tmp/command/$name"/front.csv "$out/$name/" 2>/dev/null || true
+        python3 - "$out/$name/summary.json" "$name" "$status" "$begin" "$end" <<'EOF2'
+import json, os, sys
+path, name, status, begin, end = sys.argv[1:]
+seconds = json.load(open(path)).get("seconds", {}) if os.path.exists(path) else {}
+parts = ", ".join(f"{k} {v:.2f}" for k, v in seconds.items() if isinstance(v, float))
+print(f"{name}: exit {status}, command {float(end) - float(begin):.2f} s from outside; {parts}; "
+      f"outputs' parts {seconds.get('outputs_parts', {})}")
+EOF2
+      done
+    done
+    ;;
   *)
     echo "usage: $0 bundle [PROGRAM...] | run OUTDIR [morea benchmark options] | register OUTDIR RUNDIR [SECONDS [BACKEND [OPTIONS]]]" \
       "| ab OUTDIR SECONDS BACKEND PROGRAM... | late OUTDIR SECONDS BACKEND [GENERATIONS]" \
       "| early OUTDIR GENERATIONS ROUNDS BACKEND PROGRAM... | profile OUTDIR SECONDS BACKEND GENERATIONS [OPTIONS]" \
       "| bound OUTDIR SECONDS BACKEND GENERATIONS [ROUNDS [PROGRAM...]]" \
-      "| whole OUTDIR SECONDS BACKEND LABEL PROGRAM [OPTIONS]" >&2
+      "| whole OUTDIR SECONDS BACKEND LABEL PROGRAM [OPTIONS] | command OUTDIR ROUNDS BACKEND PROGRAM..." >&2
     exit 2
     ;;
 esac

@@ -9,6 +9,7 @@
 #include "itkPreprocessing.h"
 #include "itkRigidPreAlignment.h"
 
+#include <chrono>
 #include <csignal>
 #include <filesystem>
 #include <iostream>
@@ -60,10 +61,16 @@ AddRegisterCommand(CLI::App & app)
   cmd->add_option("--kill-after-generation", options->killAfter)->group("");
   cmd->callback([options] {
     namespace fs = std::filesystem;
+    using Clock = std::chrono::steady_clock;
+    const auto started = Clock::now();
+    auto       secondsSince = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
     const auto parameters = options->parameters.Load();
     itk::morea::CheckSolutionSelection(options->select); // before a long run, not after
     const auto input = options->problem.Load();
+    const double secondsLoad = secondsSince(started);
+    auto         stage = Clock::now();
     const auto preprocessed = itk::morea::Preprocess(input, itk::morea::PreprocessOptions::FromParameters(parameters));
+    const double secondsPreprocess = secondsSince(stage);
     const auto & r = preprocessed.report;
     std::cout << "preprocessed: " << r.size[0] << "x" << r.size[1] << "x" << r.size[2] << " voxels of " << r.spacing
               << " mm around '" << r.cropStructure << "'"
@@ -86,7 +93,9 @@ AddRegisterCommand(CLI::App & app)
       if (killAfter > 0 && r.generation == killAfter)
         std::raise(SIGKILL);
     };
+    stage = Clock::now();
     const auto result = itk::morea::RegisterMeshes(preprocessed.problem, parameters, run);
+    const double secondsRegister = secondsSince(stage);
     if (result.resumedAtGeneration > 0)
       std::cout << "resumed from generation " << result.resumedAtGeneration << "\n";
     std::cout << "mesh " << result.model.base.NumberOfPoints() << " points, " << result.model.base.NumberOfTetrahedra()
@@ -95,8 +104,10 @@ AddRegisterCommand(CLI::App & app)
               << "\n";
 
     const auto chosen = ChooseSolutions(result.front, options->select);
+    const CommandTimes times{ started, secondsLoad, secondsPreprocess, secondsRegister };
     const auto summary = WriteRegistrationOutputs(preprocessed, result, chosen,
-                                                  parameters.GetReal("evaluation_border_margin"), options->output);
+                                                  parameters.GetReal("evaluation_border_margin"), options->output,
+                                                  nullptr, &times);
     for (const auto & c : chosen)
     {
       const auto & s = result.front[c.index];
@@ -109,6 +120,11 @@ AddRegisterCommand(CLI::App & app)
                     << v["hausdorff95_mm"].get<double>() << " mm (rigid "
                     << summary["rigid_baseline"]["structures"][name]["hausdorff95_mm"].get<double>() << ")\n";
     }
+    const auto & seconds = summary["seconds"];
+    std::cout << "times: load " << seconds["load"].get<double>() << " s, preprocessing "
+              << seconds["preprocessing"].get<double>() << " s, model " << seconds["model"].get<double>()
+              << " s, optimisation " << seconds["optimisation"].get<double>() << " s, outputs "
+              << seconds["outputs"].get<double>() << " s, command " << seconds["command"].get<double>() << " s\n";
     std::cout << "written to " << options->output << "\n";
   });
 }

@@ -8,9 +8,13 @@
 #include "morea/Error.h"
 #include "morea/ParetoFront.h"
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <exception>
+#include <functional>
+#include <future>
 #include <filesystem>
 #include <iostream>
 #include <sstream>
@@ -38,6 +42,64 @@ MeanDisplacementError(const itk::morea::DisplacementFieldType * field, const itk
   }
   return n ? sum / static_cast<double>(n) : 0.0;
 }
+/** Another image object over the same pixel buffer: a writer on another
+ *  thread updates only this object's pipeline state, while the rest of the
+ *  outputs read the original. */
+itk::morea::DisplacementFieldType::Pointer
+SharingBuffer(const itk::morea::DisplacementFieldType * field)
+{
+  auto view = itk::morea::DisplacementFieldType::New();
+  view->CopyInformation(field);
+  view->SetRegions(field->GetBufferedRegion());
+  view->SetPixelContainer(const_cast<itk::morea::DisplacementFieldType::PixelContainer *>(field->GetPixelContainer()));
+  return view;
+}
+
+/** File writes that run beside the rest of the outputs. Compressing a
+ *  field of doubles into .nii.gz takes about a second of one core and
+ *  gains little, and the outputs write four. HDF5 is not built to be
+ *  thread-safe, so transforms stay on the calling thread. */
+class BackgroundWrites
+{
+public:
+  ITK_DISALLOW_COPY_AND_MOVE(BackgroundWrites);
+  BackgroundWrites() = default;
+  ~BackgroundWrites()
+  {
+    for (auto & w : m_Writes) // after an error elsewhere: let them finish, errors dropped
+      if (w.valid())
+        w.wait();
+  }
+
+  void
+  Add(std::function<void()> write)
+  {
+    m_Writes.push_back(std::async(std::launch::async, std::move(write)));
+  }
+
+  /** Waits for every write; the first error, if any, is thrown. */
+  void
+  Wait()
+  {
+    std::exception_ptr error;
+    for (auto & w : m_Writes)
+      try
+      {
+        w.get();
+      }
+      catch (...)
+      {
+        if (!error)
+          error = std::current_exception();
+      }
+    m_Writes.clear();
+    if (error)
+      std::rethrow_exception(error);
+  }
+
+private:
+  std::vector<std::future<void>> m_Writes;
+};
 } // namespace
 
 std::vector<ChosenSolution>
@@ -87,10 +149,19 @@ nlohmann::json
 WriteRegistrationOutputs(const itk::morea::PreprocessResult & preprocessed,
                          const itk::morea::MeshRegistrationResult & result,
                          const std::vector<ChosenSolution> & chosen, double borderMargin, const std::string & folder,
-                         const itk::morea::DisplacementFieldType * trueFixedToMoving)
+                         const itk::morea::DisplacementFieldType * trueFixedToMoving, const CommandTimes * times)
 {
   using namespace itk::morea;
   namespace fs = std::filesystem;
+  using Clock = std::chrono::steady_clock;
+  const auto outputsStarted = Clock::now();
+  // Seconds of the outputs' parts, summed over the chosen solutions.
+  double fieldSeconds = 0.0, fileSeconds = 0.0, scoreSeconds = 0.0, renderSeconds = 0.0;
+  auto   lap = [last = Clock::now()](double & into) mutable {
+    const auto now = Clock::now();
+    into += std::chrono::duration<double>(now - last).count();
+    last = now;
+  };
   const auto & problem = preprocessed.problem;
   fs::create_directories(folder);
   const std::string out = folder + "/";
@@ -140,20 +211,26 @@ WriteRegistrationOutputs(const itk::morea::PreprocessResult & preprocessed,
   WriteTextFile(log.str(), out + "generations.csv");
 
   // The chosen solutions.
-  const bool     scored = !problem.structures.empty() || !problem.fixedLandmarks.empty();
-  nlohmann::json summary;
+  const bool       scored = !problem.structures.empty() || !problem.fixedLandmarks.empty();
+  nlohmann::json   summary;
+  BackgroundWrites writes;
+  lap(fileSeconds);
   if (scored)
     summary["rigid_baseline"] = ToJson(EvaluateRegistration(problem, nullptr, nullptr, borderMargin));
+  lap(scoreSeconds);
   for (const auto & c : chosen)
   {
     const auto &      s = result.front[c.index];
     const std::string dir = out + c.label + "/";
     fs::create_directories(dir);
     const MeshFields fields = RasterizeSolution(result.model.topology, s.mesh, problem.fixedImage, problem.movingImage);
-    WriteDisplacementField(fields.fixedToMoving, dir + "preprocessed_fixed_to_moving.nii.gz");
-    WriteDisplacementField(fields.movingToFixed, dir + "preprocessed_moving_to_fixed.nii.gz");
+    lap(fieldSeconds);
+    for (const auto & [field, name] : { std::make_pair(fields.fixedToMoving, "preprocessed_fixed_to_moving.nii.gz"),
+                                        std::make_pair(fields.movingToFixed, "preprocessed_moving_to_fixed.nii.gz") })
+      writes.Add([view = SharingBuffer(field), path = dir + name] { WriteDisplacementField(view, path); });
     WriteSolutionTransforms(fields, preprocessed.rigidTransform, dir + "fixed_to_moving.h5", dir + "moving_to_fixed.h5");
     WriteSolutionMeshes(result.model, s.mesh, dir + "mesh_moving.vtu", dir + "mesh_fixed.vtu");
+    lap(fileSeconds);
     nlohmann::json entry = { { "id", s.id },
                              { "magnitude", s.fitness.objectives[0] },
                              { "intensity", s.fitness.objectives[1] },
@@ -174,15 +251,33 @@ WriteRegistrationOutputs(const itk::morea::PreprocessResult & preprocessed,
         entry["mean_displacement_error_in_body_mm"] =
           MeanDisplacementError(fields.fixedToMoving, trueFixedToMoving, problem.fixedImage);
       WriteJson(entry, dir + "scores.json");
+      lap(scoreSeconds);
       RenderComparison(problem, fields.fixedToMoving, preprocessed.report.cropStructure, dir + "render");
+      lap(renderSeconds);
     }
     summary["solutions"][c.label] = entry;
   }
+  writes.Wait();
+  lap(fileSeconds);
   summary["front_size"] = result.front.size();
   summary["generations"] = result.history.empty() ? 0 : result.history.back().generation;
   summary["backend"] = result.backend;
   summary["threads"] = result.threads;
   summary["seconds"] = { { "model", result.secondsModel }, { "optimisation", result.secondsOptimisation } };
+  if (times)
+  {
+    // summary.json's own writing is the only part left out.
+    auto & seconds = summary["seconds"];
+    seconds["load"] = times->load;
+    seconds["preprocessing"] = times->preprocessing;
+    seconds["registration_other"] = times->registration - result.secondsModel - result.secondsOptimisation;
+    seconds["outputs"] = std::chrono::duration<double>(Clock::now() - outputsStarted).count();
+    seconds["outputs_parts"] = { { "fields", fieldSeconds },
+                                 { "files", fileSeconds },
+                                 { "scores", scoreSeconds },
+                                 { "renders", renderSeconds } };
+    seconds["command"] = std::chrono::duration<double>(Clock::now() - times->started).count();
+  }
   WriteJson(summary, out + "summary.json");
   return summary;
 }

@@ -7,6 +7,7 @@
 #include "itkMeshRegistration.h"
 #include "itkPreprocessing.h"
 
+#include <chrono>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,15 @@ struct ChosenSolution
 {
   std::string label; ///< "best_guidance", "knee", ...
   std::size_t index{ 0 }; ///< into the front
+};
+
+/** Where a command's time went before its outputs (`morea register`). */
+struct CommandTimes
+{
+  std::chrono::steady_clock::time_point started; ///< the command's start
+  double                                load{ 0.0 };          ///< reading the problem
+  double                                preprocessing{ 0.0 }; ///< resampling, pre-alignment, cropping
+  double                                registration{ 0.0 };  ///< model and optimisation (RegisterMeshes)
 };
 
 /** Parses "best-guidance,knee,weighted:1:1:2,nearest:m:i:g,all" into front indices. */
@@ -32,12 +42,14 @@ ProgressPrinter();
  *  folder with both fields (NIfTI, preprocessed frame), both transforms (.h5,
  *  original images' space), both meshes (.vtu) and, when the fixed structures
  *  are known, scores.json and renders; returns the scores as JSON (also
- *  written to summary.json with the baseline). */
+ *  written to summary.json with the baseline and, where `times` is given,
+ *  the seconds of each stage, the outputs' parts included). */
 nlohmann::json
 WriteRegistrationOutputs(const itk::morea::PreprocessResult & preprocessed,
                          const itk::morea::MeshRegistrationResult & result,
                          const std::vector<ChosenSolution> & chosen, double borderMargin, const std::string & folder,
-                         const itk::morea::DisplacementFieldType * trueFixedToMoving = nullptr);
+                         const itk::morea::DisplacementFieldType * trueFixedToMoving = nullptr,
+                         const CommandTimes * times = nullptr);
 } // namespace morea::cli
 
 #endif

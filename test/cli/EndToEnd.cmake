@@ -269,6 +269,26 @@ json_number(reg_fold "summary.json" "${reg_json}" solutions best_guidance scores
 if(reg_fold GREATER 0)
   message(FATAL_ERROR "register: the best-guidance solution folds (Jacobian <= 0 in ${reg_fold} of the voxels)")
 endif()
+# Stage times: the command's whole time covers its stages; the fields written
+# beside the rest of the outputs are whole gzip files.
+json_number(reg_command "summary.json" "${reg_json}" seconds command)
+json_number(reg_outputs "summary.json" "${reg_json}" seconds outputs)
+json_number(reg_optimisation "summary.json" "${reg_json}" seconds optimisation)
+json_number(reg_load "summary.json" "${reg_json}" seconds load)
+json_number(reg_files "summary.json" "${reg_json}" seconds outputs_parts files)
+if(reg_command LESS reg_optimisation OR reg_command LESS reg_outputs OR reg_outputs LESS reg_files OR NOT reg_load GREATER 0)
+  message(FATAL_ERROR "register: stage times do not add up: command ${reg_command} s, optimisation "
+          "${reg_optimisation} s, outputs ${reg_outputs} s (files ${reg_files} s), load ${reg_load} s")
+endif()
+if(NOT MOREA_STDOUT MATCHES "times: load [0-9.e-]+ s, preprocessing")
+  message(FATAL_ERROR "register: stdout lacks the stage times:\n${MOREA_STDOUT}")
+endif()
+foreach(f preprocessed_fixed_to_moving preprocessed_moving_to_fixed)
+  file(READ "${reg}/knee/${f}.nii.gz" head LIMIT 2 HEX)
+  if(NOT head STREQUAL "1f8b")
+    message(FATAL_ERROR "register: knee/${f}.nii.gz is not a gzip file (starts with ${head})")
+  endif()
+endforeach()
 
 file(READ "${reg}/generations.csv" gen_csv)
 if(NOT gen_csv MATCHES "seconds_device_kernels,seconds_device_span,samples")
