@@ -315,9 +315,9 @@ EOF2
 import json, os, sys
 path, name, status, begin, end = sys.argv[1:]
 seconds = json.load(open(path)).get("seconds", {}) if os.path.exists(path) else {}
-parts = ", ".join(f"{k} {v:.2f}" for k, v in seconds.items() if isinstance(v, float))
-print(f"{name}: exit {status}, command {float(end) - float(begin):.2f} s from outside; {parts}; "
-      f"outputs' parts {seconds.get('outputs_parts', {})}")
+def show(d):
+    return ", ".join(f"{k} {v:.2f}" if isinstance(v, float) else f"{k} ({show(v)})" for k, v in d.items())
+print(f"{name}: exit {status}, command {float(end) - float(begin):.2f} s from outside; {show(seconds)}")
 EOF2
       done
     done

@@ -61,7 +61,10 @@ struct MeshRegistrationResult
   std::string                            backend;
   std::size_t                            threads{ 0 };
   std::size_t                            resumedAtGeneration{ 0 }; ///< 0 when started afresh
-  double                                 secondsModel{ 0.0 };
+  double                                 secondsModel{ 0.0 }; ///< the three below together
+  double                                 secondsMesh{ 0.0 };          ///< mesh model (points, tetrahedra, groups)
+  double                                 secondsObjectiveData{ 0.0 }; ///< images, distance maps, samples
+  double                                 secondsBackend{ 0.0 };       ///< the backend made (device set-up)
   double                                 secondsOptimisation{ 0.0 };
 };
 

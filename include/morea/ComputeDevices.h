@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace morea
@@ -31,6 +32,23 @@ ListCudaDevices();
 /** Why ListCudaDevices() is empty, or "" when it is not. */
 std::string
 CudaUnavailableReason();
+/** Sets up device 0's CUDA context on a thread of its own while the caller
+ *  goes on (reading and preprocessing images), so that a CUDA backend made
+ *  later does not wait for it; waits for that thread when destroyed. Errors
+ *  are left for the backend to report. Does nothing without CUDA. */
+class CudaContextWarmUp
+{
+public:
+  CudaContextWarmUp();
+  ~CudaContextWarmUp();
+  CudaContextWarmUp(const CudaContextWarmUp &) = delete;
+  CudaContextWarmUp &
+  operator=(const CudaContextWarmUp &) = delete;
+
+private:
+  std::thread m_Thread;
+};
+
 /** Bytes of device 0's memory in use (total - free); 0 without a device. */
 std::size_t
 CudaMemoryInUse();

@@ -8,12 +8,14 @@
 #include "itkMultiObjectiveMeshRegistrationFilterSupport.h"
 #include "itkPreprocessing.h"
 #include "itkRigidPreAlignment.h"
+#include "morea/ComputeDevices.h"
 
 #include <chrono>
 #include <csignal>
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 namespace morea::cli
 {
@@ -63,6 +65,10 @@ AddRegisterCommand(CLI::App & app)
     namespace fs = std::filesystem;
     using Clock = std::chrono::steady_clock;
     const auto started = Clock::now();
+    // The device's context is made while the problem is read and preprocessed.
+    std::optional<::morea::CudaContextWarmUp> warmUp;
+    if (options->backend != "cpu")
+      warmUp.emplace();
     auto       secondsSince = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
     const auto parameters = options->parameters.Load();
     itk::morea::CheckSolutionSelection(options->select); // before a long run, not after

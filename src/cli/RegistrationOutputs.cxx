@@ -71,9 +71,14 @@ public:
         w.wait();
   }
 
+  /** Starts `write` on a thread of its own; with `MaximumInFlight` writes
+   *  running, first waits for the oldest (each holds its field, and
+   *  `--select all` may write hundreds). */
   void
   Add(std::function<void()> write)
   {
+    if (m_Writes.size() - m_Done == MaximumInFlight)
+      m_Writes[m_Done++].get(); // its error, if any, stops the outputs here
     m_Writes.push_back(std::async(std::launch::async, std::move(write)));
   }
 
@@ -82,10 +87,10 @@ public:
   Wait()
   {
     std::exception_ptr error;
-    for (auto & w : m_Writes)
+    for (std::size_t i = m_Done; i < m_Writes.size(); ++i)
       try
       {
-        w.get();
+        m_Writes[i].get();
       }
       catch (...)
       {
@@ -93,12 +98,15 @@ public:
           error = std::current_exception();
       }
     m_Writes.clear();
+    m_Done = 0;
     if (error)
       std::rethrow_exception(error);
   }
 
 private:
+  static constexpr std::size_t   MaximumInFlight{ 4 };
   std::vector<std::future<void>> m_Writes;
+  std::size_t                    m_Done{ 0 }; ///< m_Writes[0, m_Done) are waited for
 };
 } // namespace
 
@@ -270,6 +278,9 @@ WriteRegistrationOutputs(const itk::morea::PreprocessResult & preprocessed,
     auto & seconds = summary["seconds"];
     seconds["load"] = times->load;
     seconds["preprocessing"] = times->preprocessing;
+    seconds["model_parts"] = { { "mesh", result.secondsMesh },
+                               { "objective_data", result.secondsObjectiveData },
+                               { "backend", result.secondsBackend } };
     seconds["registration_other"] = times->registration - result.secondsModel - result.secondsOptimisation;
     seconds["outputs"] = std::chrono::duration<double>(Clock::now() - outputsStarted).count();
     seconds["outputs_parts"] = { { "fields", fieldSeconds },

@@ -53,4 +53,19 @@ CudaUnavailableReason()
   }
   return count == 0 ? "no CUDA device present" : "";
 }
+
+CudaContextWarmUp::CudaContextWarmUp()
+  : m_Thread([] {
+    // The runtime creates the primary context on its first call that
+    // needs one; later calls on any thread find it made.
+    if (cudaSetDevice(0) != cudaSuccess || cudaFree(nullptr) != cudaSuccess)
+      cudaGetLastError(); // the backend reports what is wrong when it is made
+  })
+{}
+
+CudaContextWarmUp::~CudaContextWarmUp()
+{
+  if (m_Thread.joinable())
+    m_Thread.join();
+}
 } // namespace morea

@@ -23,6 +23,10 @@ CudaUnavailableReason()
   return "this build has no CUDA backend (nvcc was not found when it was configured)";
 }
 
+CudaContextWarmUp::CudaContextWarmUp() = default;
+
+CudaContextWarmUp::~CudaContextWarmUp() = default;
+
 std::size_t
 CudaMemoryInUse()
 {

@@ -25,17 +25,26 @@ RegisterMeshes(const RegistrationProblem & problem, const ::morea::ParameterSet 
 {
   using Clock = std::chrono::steady_clock;
   auto                   start = Clock::now();
+  auto                   lap = [&start] {
+    const auto now = Clock::now();
+    const double seconds = std::chrono::duration<double>(now - start).count();
+    start = now;
+    return seconds;
+  };
   MeshRegistrationResult result;
   result.model = BuildMeshModel(problem, parameters);
-  const MeshModel &             model = result.model;
-  const ::morea::ObjectiveData  data = BuildObjectiveData(problem, model, parameters);
+  const MeshModel & model = result.model;
+  result.secondsMesh = lap();
+  const ::morea::ObjectiveData data = BuildObjectiveData(problem, model, parameters);
+  result.secondsObjectiveData = lap();
   const ::morea::FoldConstraint constraint(model.topology, model.base.points,
                                                 parameters.GetReal("morea_fold_volume_fraction"));
   const ::morea::TetrahedronEvaluator evaluator(model.topology, constraint, model.elasticity, data);
   auto backend = ::morea::CreateEvaluationBackend(options.backend, evaluator, options.threads);
   result.backend = backend->Name();
   result.threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
-  result.secondsModel = std::chrono::duration<double>(Clock::now() - start).count();
+  result.secondsBackend = lap();
+  result.secondsModel = result.secondsMesh + result.secondsObjectiveData + result.secondsBackend;
 
   start = Clock::now();
   ::morea::GomeaOptions gomea = ::morea::GomeaOptions::FromParameters(parameters);

@@ -10,6 +10,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <functional>
+#include <future>
 #include <utility>
 
 namespace itk
@@ -220,47 +222,72 @@ RasterizeSolution(const ::morea::MeshTopology & topology, const ::morea::DualMes
                              << "fixed: " << fixedGrid->GetDirection() << " moving: " << movingGrid->GetDirection());
   }
 
-  // The map `from` -> `to`, sampled on `grid`, as a physical displacement field.
-  auto rasterize = [&](const std::vector<::morea::Vec3> & from,
-                       const std::vector<::morea::Vec3> & to,
-                       const ImageBase<Dimension> *       grid,
-                       ::morea::RasterizationReport *     report,
-                       ::morea::FieldFoldRepairReport *   repair) {
-    auto volume = frame.FieldGridOf(grid);
+  // The map `from` -> `to` sampled on a grid's volume (plain C++, no ITK
+  // objects made, so that both directions can run at once: the voxel fold
+  // repair is serial and takes a good part of a second on a folded field).
+  struct Rasterized
+  {
+    ::morea::Volume<::morea::Vec3>  volume;
+    ::morea::RasterizationReport    report;
+    ::morea::FieldFoldRepairReport repair;
+  };
+  auto rasterizeVolume = [&topology](const std::vector<::morea::Vec3> & from, const std::vector<::morea::Vec3> & to,
+                                     ::morea::Volume<::morea::Vec3> volume) {
+    Rasterized r{ std::move(volume), {}, {} };
+    ::morea::RasterizeDisplacement(topology, from, to, r.volume, &r.report);
+    r.repair = ::morea::RemoveVoxelFolds(r.volume);
+    return r;
+  };
+  // ... and as a physical displacement field on the grid's full geometry.
+  auto toField = [&frame](const Rasterized & r, const ImageBase<Dimension> * grid) {
+    DisplacementFieldType::Pointer field = MakeIdentityField(grid);
+    DisplacementVectorType *       buffer = field->GetBufferPointer();
+    for (std::size_t i = 0; i < r.volume.data.size(); ++i)
+    {
+      buffer[i] = frame.VectorToPhysical(r.volume.data[i]);
+    }
+    return field;
+  };
+  auto rasterize = [&](const std::vector<::morea::Vec3> & from, const std::vector<::morea::Vec3> & to,
+                       const ImageBase<Dimension> * grid) {
     try
     {
-      ::morea::RasterizeDisplacement(topology, from, to, volume, report);
-      const ::morea::FieldFoldRepairReport repaired = ::morea::RemoveVoxelFolds(volume);
-      if (repair != nullptr)
-      {
-        *repair = repaired;
-      }
+      return toField(rasterizeVolume(from, to, frame.FieldGridOf(grid)), grid);
     }
     catch (const ::morea::Error & e)
     {
       itkGenericExceptionMacro(<< e.what());
     }
-    DisplacementFieldType::Pointer field = MakeIdentityField(grid); // the grid's full geometry
-    DisplacementVectorType *       buffer = field->GetBufferPointer();
-    for (std::size_t i = 0; i < volume.data.size(); ++i)
-    {
-      buffer[i] = frame.VectorToPhysical(volume.data[i]);
-    }
-    return field;
   };
 
   MeshFields fields;
-  fields.fixedToMoving =
-    rasterize(solution.target, solution.source, fixedGrid, &fields.fixedReport, &fields.fixedFoldRepair);
-  fields.movingToFixed =
-    rasterize(solution.source, solution.target, movingGrid, &fields.movingReport, &fields.movingFoldRepair);
+  {
+    Rasterized forward, backward;
+    try
+    {
+      auto later = std::async(std::launch::async, rasterizeVolume, std::cref(solution.source),
+                              std::cref(solution.target), frame.FieldGridOf(movingGrid));
+      forward = rasterizeVolume(solution.target, solution.source, frame.FieldGridOf(fixedGrid));
+      backward = later.get();
+    }
+    catch (const ::morea::Error & e)
+    {
+      itkGenericExceptionMacro(<< e.what());
+    }
+    fields.fixedToMoving = toField(forward, fixedGrid);
+    fields.fixedReport = forward.report;
+    fields.fixedFoldRepair = forward.repair;
+    fields.movingToFixed = toField(backward, movingGrid);
+    fields.movingReport = backward.report;
+    fields.movingFoldRepair = backward.repair;
+  }
 
   // ITK wants a transform's inverse field on its forward field's grid.
   const bool                     sameGrid = SameGrid(fixedGrid, movingGrid, 1e-9);
   DisplacementFieldType::Pointer movingToFixedOnFixedGrid =
-    sameGrid ? fields.movingToFixed : rasterize(solution.source, solution.target, fixedGrid, nullptr, nullptr);
+    sameGrid ? fields.movingToFixed : rasterize(solution.source, solution.target, fixedGrid);
   DisplacementFieldType::Pointer fixedToMovingOnMovingGrid =
-    sameGrid ? fields.fixedToMoving : rasterize(solution.target, solution.source, movingGrid, nullptr, nullptr);
+    sameGrid ? fields.fixedToMoving : rasterize(solution.target, solution.source, movingGrid);
 
   fields.fixedToMovingTransform = DisplacementFieldTransformType::New();
   fields.fixedToMovingTransform->SetDisplacementField(fields.fixedToMoving);
