@@ -17,6 +17,7 @@
 #include <future>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <sstream>
 #include <unistd.h>
 
@@ -223,19 +224,36 @@ WriteRegistrationOutputs(const itk::morea::PreprocessResult & preprocessed,
   nlohmann::json   summary;
   BackgroundWrites writes;
   lap(fileSeconds);
-  if (scored)
-    summary["rigid_baseline"] = ToJson(EvaluateRegistration(problem, nullptr, nullptr, borderMargin));
-  lap(scoreSeconds);
-  for (const auto & c : chosen)
+  auto rasterize = [&](std::size_t i) {
+    return RasterizeSolution(result.model.topology, result.front[chosen[i].index].mesh, problem.fixedImage,
+                             problem.movingImage);
+  };
+  // Each solution's fields are made one solution ahead, so that its slow
+  // .nii.gz writes start before the last solution's transforms, scores and
+  // renders rather than after them; at most two solutions' fields are held.
+  std::optional<MeshFields> next;
+  for (std::size_t i = 0; i < chosen.size(); ++i)
   {
+    const auto &      c = chosen[i];
     const auto &      s = result.front[c.index];
     const std::string dir = out + c.label + "/";
     fs::create_directories(dir);
-    const MeshFields fields = RasterizeSolution(result.model.topology, s.mesh, problem.fixedImage, problem.movingImage);
+    const MeshFields fields = next ? std::move(*next) : rasterize(i);
     lap(fieldSeconds);
     for (const auto & [field, name] : { std::make_pair(fields.fixedToMoving, "preprocessed_fixed_to_moving.nii.gz"),
                                         std::make_pair(fields.movingToFixed, "preprocessed_moving_to_fixed.nii.gz") })
       writes.Add([view = SharingBuffer(field), path = dir + name] { WriteDisplacementField(view, path); });
+    if (i == 0 && scored)
+    {
+      summary["rigid_baseline"] = ToJson(EvaluateRegistration(problem, nullptr, nullptr, borderMargin));
+      lap(scoreSeconds);
+    }
+    next.reset();
+    if (i + 1 < chosen.size())
+    {
+      next = rasterize(i + 1);
+      lap(fieldSeconds);
+    }
     WriteSolutionTransforms(fields, preprocessed.rigidTransform, dir + "fixed_to_moving.h5", dir + "moving_to_fixed.h5");
     WriteSolutionMeshes(result.model, s.mesh, dir + "mesh_moving.vtu", dir + "mesh_fixed.vtu");
     lap(fileSeconds);
@@ -267,6 +285,8 @@ WriteRegistrationOutputs(const itk::morea::PreprocessResult & preprocessed,
   }
   writes.Wait();
   lap(fileSeconds);
+  if (chosen.empty() && scored)
+    summary["rigid_baseline"] = ToJson(EvaluateRegistration(problem, nullptr, nullptr, borderMargin));
   summary["front_size"] = result.front.size();
   summary["generations"] = result.history.empty() ? 0 : result.history.back().generation;
   summary["backend"] = result.backend;
