@@ -56,10 +56,11 @@ SharingBuffer(const itk::morea::DisplacementFieldType * field)
   return view;
 }
 
-/** File writes that run beside the rest of the outputs. Compressing a
- *  field of doubles into .nii.gz takes about a second of one core and
- *  gains little, and the outputs write four. HDF5 is not built to be
- *  thread-safe, so transforms stay on the calling thread. */
+/** File writes that run beside the rest of the outputs: a field of doubles
+ *  written as .nii.gz is mostly deflate (about a second of one core for a
+ *  chosen solution's field here), and the outputs write two per solution.
+ *  HDF5 is not built to be thread-safe, so transforms stay on the calling
+ *  thread. */
 class BackgroundWrites
 {
 public:

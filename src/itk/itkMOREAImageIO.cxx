@@ -8,6 +8,8 @@
 #include "itkImageRegionIterator.h"
 #include "itkImageSeriesReader.h"
 
+#include "ParallelGzip.h"
+
 #include <zlib.h>
 
 #include <algorithm>
@@ -451,20 +453,31 @@ WriteFileAtomically(const TImage * image, const std::string & path)
     Fail("cannot write '" + path + "': cannot create temporary folder '" + folder.string() + "'");
   }
   const fs::path staged = folder / target.filename();
-  auto           writer = ImageFileWriter<TImage>::New();
+  // NIfTI is written plain and gzipped here on several threads
+  // (ParallelGzip.h): ITK's writer deflates on one.
+  const std::string name = LowerCase(target.filename().string());
+  const bool        gzipAfter = name.size() > 7 && name.compare(name.size() - 7, 7, ".nii.gz") == 0;
+  const fs::path    written = gzipAfter ? folder / target.stem() : staged; // "x.nii.gz" -> "x.nii"
+  auto              writer = ImageFileWriter<TImage>::New();
   writer->SetInput(image);
-  writer->SetFileName(staged.string());
-  writer->SetUseCompression(true);
+  writer->SetFileName(written.string());
+  writer->SetUseCompression(!gzipAfter);
   try
   {
     writer->Update();
-    if (!fs::exists(staged))
+    if (!fs::exists(written))
     {
       Fail("the writer produced no file");
     }
+    if (gzipAfter)
+    {
+      GzipFileInChunks(written.string(), staged.string());
+      std::error_code removed;
+      fs::remove(written, removed); // the folder goes below in any case
+    }
     for (const auto & entry : fs::directory_iterator(folder))
     {
-      if (entry.path() != staged)
+      if (entry.path() != staged && entry.path() != written)
       {
         CommitFile(entry.path().string(), (parent / entry.path().filename()).string());
       }
