@@ -228,3 +228,38 @@ TEST(Preprocessing, UnknownStructuresAndBadOptionsAreErrors)
   pre.windowMax = -100.0f;
   EXPECT_THROW(Preprocess(problem, pre), itk::ExceptionObject);
 }
+
+TEST(Preprocessing, MaskBoundingBoxOfVoxelsAtRowEndsInARegionNotAtTheOrigin)
+{
+  // A buffer whose region starts at (3, -2, 5), 1 mm voxels at the origin 0:
+  // the box must hold the index offset, and voxels at the first and the last
+  // place of their rows.
+  auto                      mask = MaskType::New();
+  const MaskType::IndexType start{ { 3, -2, 5 } };
+  const MaskType::SizeType  size{ { 7, 6, 4 } };
+  mask->SetRegions(MaskType::RegionType(start, size));
+  mask->Allocate(true);
+  PointType lower, upper;
+  EXPECT_THROW(MaskBoundingBox(mask, lower, upper), itk::ExceptionObject); // empty
+  mask->SetPixel({ { 3, 1, 6 } }, 1); // first and last of one row
+  mask->SetPixel({ { 9, 1, 6 } }, 1);
+  mask->SetPixel({ { 5, -2, 8 } }, 1); // first row, last slice
+  MaskBoundingBox(mask, lower, upper);
+  const double expectedLower[3] = { 3 - 0.5, -2 - 0.5, 6 - 0.5 };
+  const double expectedUpper[3] = { 9 + 0.5, 1 + 0.5, 8 + 0.5 };
+  for (unsigned d = 0; d < 3; ++d)
+  {
+    EXPECT_DOUBLE_EQ(lower[d], expectedLower[d]) << d;
+    EXPECT_DOUBLE_EQ(upper[d], expectedUpper[d]) << d;
+  }
+  // One voxel alone gives its own box, wherever it lies in its row.
+  mask->FillBuffer(0);
+  mask->SetPixel({ { 6, 3, 7 } }, 255);
+  MaskBoundingBox(mask, lower, upper);
+  for (unsigned d = 0; d < 3; ++d)
+  {
+    const double centre = d == 0 ? 6 : d == 1 ? 3 : 7;
+    EXPECT_DOUBLE_EQ(lower[d], centre - 0.5) << d;
+    EXPECT_DOUBLE_EQ(upper[d], centre + 0.5) << d;
+  }
+}
