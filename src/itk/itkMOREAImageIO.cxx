@@ -455,7 +455,8 @@ WriteFileAtomically(const TImage * image, const std::string & path)
   const fs::path staged = folder / target.filename();
   // NIfTI is written plain and gzipped here on several threads
   // (ParallelGzip.h): ITK's writer deflates on one.
-  const std::string name = LowerCase(target.filename().string());
+  // (Other spellings, .NII.GZ say, are left to ITK's writer as they were.)
+  const std::string name = target.filename().string();
   const bool        gzipAfter = name.size() > 7 && name.compare(name.size() - 7, 7, ".nii.gz") == 0;
   const fs::path    written = gzipAfter ? folder / target.stem() : staged; // "x.nii.gz" -> "x.nii"
   auto              writer = ImageFileWriter<TImage>::New();
