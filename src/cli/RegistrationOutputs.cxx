@@ -244,11 +244,6 @@ WriteRegistrationOutputs(const itk::morea::PreprocessResult & preprocessed,
     for (const auto & [field, name] : { std::make_pair(fields.fixedToMoving, "preprocessed_fixed_to_moving.nii.gz"),
                                         std::make_pair(fields.movingToFixed, "preprocessed_moving_to_fixed.nii.gz") })
       writes.Add([view = SharingBuffer(field), path = dir + name] { WriteDisplacementField(view, path); });
-    if (i == 0 && scored)
-    {
-      summary["rigid_baseline"] = ToJson(EvaluateRegistration(problem, nullptr, nullptr, borderMargin));
-      lap(scoreSeconds);
-    }
     next.reset();
     if (i + 1 < chosen.size())
     {
@@ -284,10 +279,12 @@ WriteRegistrationOutputs(const itk::morea::PreprocessResult & preprocessed,
     }
     summary["solutions"][c.label] = entry;
   }
+  // The baseline's scores while the last fields are written.
+  if (scored)
+    summary["rigid_baseline"] = ToJson(EvaluateRegistration(problem, nullptr, nullptr, borderMargin));
+  lap(scoreSeconds);
   writes.Wait();
   lap(fileSeconds);
-  if (chosen.empty() && scored)
-    summary["rigid_baseline"] = ToJson(EvaluateRegistration(problem, nullptr, nullptr, borderMargin));
   summary["front_size"] = result.front.size();
   summary["generations"] = result.history.empty() ? 0 : result.history.back().generation;
   summary["backend"] = result.backend;

@@ -1,11 +1,10 @@
 #include "morea/InitialPopulation.h"
 
+#include "morea/ParallelForThreads.h"
 #include "morea/ParameterSet.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
-#include <thread>
 
 namespace morea
 {
@@ -114,22 +113,13 @@ GenerateInitialPopulation(const TetrahedralMesh & base, const FoldConstraint & c
                           std::uint64_t seed, const InitialPopulationOptions & options)
 {
   std::vector<DualMesh> population(size, DualMesh::FromBase(base));
-  std::atomic<std::size_t> next{ 1 };
-  const auto work = [&]() {
-    for (std::size_t i = next++; i < size; i = next++)
-    {
-      RandomGenerator random(HashCombine(HashCombine(seed, 0x696e6974ull), i)); // "init"
-      ApplyRadialBasisDeformation(population[i].source, base, constraint, random, options);
-      ApplyRadialBasisDeformation(population[i].target, base, constraint, random, options);
-    }
-  };
-  const std::size_t threads = std::max<std::size_t>(1, std::min<std::size_t>(std::thread::hardware_concurrency(), size));
-  std::vector<std::thread> pool;
-  for (std::size_t t = 1; t < threads; ++t)
-    pool.emplace_back(work);
-  work();
-  for (auto & t : pool)
-    t.join();
+  // Solution 0 stays the base mesh.
+  ParallelForOnNewThreads(size > 0 ? size - 1 : 0, [&](std::size_t item) {
+    const std::size_t i = item + 1;
+    RandomGenerator   random(HashCombine(HashCombine(seed, 0x696e6974ull), i)); // "init"
+    ApplyRadialBasisDeformation(population[i].source, base, constraint, random, options);
+    ApplyRadialBasisDeformation(population[i].target, base, constraint, random, options);
+  });
   return population;
 }
 } // namespace morea

@@ -1,14 +1,13 @@
 #include "morea/MeshRasterizer.h"
 
 #include "morea/Error.h"
+#include "morea/ParallelForThreads.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <string>
-#include <thread>
 
 namespace morea
 {
@@ -139,32 +138,6 @@ DisplacementAt(const TetrahedronMap & m, const Vec3 & x)
     u[d] = m.anchorDisplacement[d] + m.gradient[d][0] * r[0] + m.gradient[d][1] * r[1] + m.gradient[d][2] * r[2];
   }
   return u;
-}
-
-/** Runs body(item) for items [0, count) on all cores, handing out items one by one. */
-template <typename TBody>
-void
-ParallelFor(std::size_t count, TBody body)
-{
-  const std::size_t threads =
-    std::max<std::size_t>(1, std::min<std::size_t>(count, std::thread::hardware_concurrency()));
-  std::atomic<std::size_t> next{ 0 };
-  auto                     worker = [&] {
-    for (std::size_t item = next++; item < count; item = next++)
-    {
-      body(item);
-    }
-  };
-  std::vector<std::thread> pool;
-  for (std::size_t t = 1; t < threads; ++t)
-  {
-    pool.emplace_back(worker);
-  }
-  worker();
-  for (auto & th : pool)
-  {
-    th.join();
-  }
 }
 
 /** Marks each voxel of the tetrahedron's scanlines within slices [kBegin, kEnd)
@@ -342,7 +315,7 @@ RasterizeDisplacement(const MeshTopology & topology, const std::vector<Vec3> & f
   }
 
   std::vector<TetrahedronMap> maps(tetrahedra.size());
-  ParallelFor(tetrahedra.size(), [&](std::size_t t) { maps[t] = MakeTetrahedronMap(tetrahedra[t], from, to, field); });
+  ParallelForOnNewThreads(tetrahedra.size(), [&](std::size_t t) { maps[t] = MakeTetrahedronMap(tetrahedra[t], from, to, field); });
 
   // Ownership by z-slabs: each slab is written by one thread only, and within a
   // slab the lowest tetrahedron index wins, whatever the order of work.
@@ -360,7 +333,7 @@ RasterizeDisplacement(const MeshTopology & topology, const std::vector<Vec3> & f
     }
   }
   std::vector<std::uint32_t> owner(voxels, NoTetrahedron);
-  ParallelFor(slabs, [&](std::size_t s) {
+  ParallelForOnNewThreads(slabs, [&](std::size_t s) {
     const std::size_t kBegin = s * SlabThickness;
     const std::size_t kEnd = std::min(kBegin + SlabThickness, field.size[2]);
     for (std::uint32_t t : slabTetrahedra[s])
@@ -382,7 +355,7 @@ RasterizeDisplacement(const MeshTopology & topology, const std::vector<Vec3> & f
   // Each voxel evaluates its owner's affine map (extrapolating outside the mesh).
   const std::size_t nx = field.size[0];
   const std::size_t ny = field.size[1];
-  ParallelFor(field.size[2], [&](std::size_t k) {
+  ParallelForOnNewThreads(field.size[2], [&](std::size_t k) {
     for (std::size_t j = 0; j < ny; ++j)
     {
       for (std::size_t i = 0; i < nx; ++i)

@@ -1,15 +1,14 @@
 #include "ParallelGzip.h"
 
 #include "itkMacro.h"
+#include "morea/ParallelForThreads.h"
 
 #include <zlib.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cstdint>
 #include <fstream>
 #include <iterator>
-#include <thread>
 #include <vector>
 
 namespace itk
@@ -24,6 +23,7 @@ constexpr std::size_t WindowBytes = 32768; // deflate's largest back-reference
 struct Piece
 {
   std::vector<unsigned char> bytes;
+  std::size_t                length{ 0 }; ///< of the input it deflates
   uLong                      crc{ 0 };
   std::string                error; ///< empty when deflated
 };
@@ -42,6 +42,7 @@ DeflatePiece(const unsigned char * data, std::size_t begin, std::size_t end, boo
   if (primed > 0 && deflateSetDictionary(&s, data + begin - primed, static_cast<uInt>(primed)) != Z_OK)
     piece.error = "deflateSetDictionary failed";
   const std::size_t length = end - begin;
+  piece.length = length;
   piece.crc = crc32(0L, data + begin, static_cast<uInt>(length));
   // Room for incompressible data plus the sync flush's empty stored block;
   // grown below should deflate still need more.
@@ -92,38 +93,24 @@ GzipFileInChunks(const std::string & from, const std::string & to, std::size_t c
   if (in.bad())
     itkGenericExceptionMacro(<< "gzip: cannot read '" << from << "'");
 
-  const std::size_t        chunks = std::max<std::size_t>(1, (data.size() + chunkBytes - 1) / chunkBytes);
-  std::vector<Piece>       pieces(chunks);
-  std::atomic<std::size_t> next{ 0 };
-  auto                     work = [&] {
-    for (std::size_t i; (i = next++) < chunks;)
-    {
-      const std::size_t begin = i * chunkBytes;
-      const std::size_t end = std::min(data.size(), begin + chunkBytes);
-      pieces[i] = DeflatePiece(data.data(), begin, end, i + 1 == chunks);
-    }
-  };
-  const std::size_t        threads = std::min<std::size_t>(chunks, std::max(1u, std::thread::hardware_concurrency()));
-  std::vector<std::thread> helpers;
-  for (std::size_t t = 1; t < threads; ++t)
-    helpers.emplace_back(work);
-  work();
-  for (auto & h : helpers)
-    h.join();
+  const std::size_t  chunks = std::max<std::size_t>(1, (data.size() + chunkBytes - 1) / chunkBytes);
+  std::vector<Piece> pieces(chunks);
+  ::morea::ParallelForOnNewThreads(chunks, [&](std::size_t i) {
+    const std::size_t begin = i * chunkBytes;
+    pieces[i] = DeflatePiece(data.data(), begin, std::min(data.size(), begin + chunkBytes), i + 1 == chunks);
+  });
 
   std::ofstream out(to, std::ios::binary | std::ios::trunc);
   // Header: magic, deflate, no flags, no time, no extra flags, Unix.
   const unsigned char header[10] = { 0x1f, 0x8b, 8, 0, 0, 0, 0, 0, 0, 3 };
   out.write(reinterpret_cast<const char *>(header), sizeof header);
   uLong crc = crc32(0L, Z_NULL, 0);
-  for (std::size_t i = 0; i < chunks; ++i)
+  for (const Piece & p : pieces)
   {
-    const Piece & p = pieces[i];
     if (!p.error.empty())
       itkGenericExceptionMacro(<< "gzip of '" << from << "': " << p.error);
     out.write(reinterpret_cast<const char *>(p.bytes.data()), static_cast<std::streamsize>(p.bytes.size()));
-    const std::size_t begin = i * chunkBytes;
-    crc = crc32_combine(crc, p.crc, static_cast<z_off_t>(std::min(data.size(), begin + chunkBytes) - begin));
+    crc = crc32_combine(crc, p.crc, static_cast<z_off_t>(p.length));
   }
   PutLittleEndian32(out, static_cast<std::uint32_t>(crc));
   PutLittleEndian32(out, static_cast<std::uint32_t>(data.size())); // the size modulo 2^32, as gzip keeps it
