@@ -680,8 +680,28 @@ private:
         const double x = std::clamp(static_cast<double>(volume.data[volume.channels * v]), 0.0, 1.0);
         intensity[v] = x > 0.0 ? static_cast<std::uint16_t>(std::max(1.0, std::round(x * 65535.0))) : 0;
       }
-      textures.intensity = std::make_unique<cuda::Texture3D>(
-        intensity.data(), sizeof(std::uint16_t), cudaCreateChannelDesc<unsigned short>(), view.size);
+      // Slice pairs: layer l holds slices l - 1 and l (clamped to the image)
+      // as two channels of one 32-bit texel, so that one bilinear fetch
+      // gives both slices around a point and trilinear interpolation takes
+      // one filtering pass instead of a 3D texture's two.
+      const std::size_t          slice = volume.size[0] * volume.size[1];
+      const int                  depth = view.size[2];
+      std::vector<std::uint16_t> pairs(2 * slice * (depth + 1));
+      for (int l = 0; l <= depth; ++l)
+      {
+        const std::uint16_t * below = intensity.data() + std::max(l - 1, 0) * slice;
+        const std::uint16_t * above = intensity.data() + std::min(l, depth - 1) * slice;
+        std::uint16_t *       out = pairs.data() + 2 * slice * l;
+        for (std::size_t v = 0; v < slice; ++v)
+        {
+          out[2 * v] = below[v];
+          out[2 * v + 1] = above[v];
+        }
+      }
+      const int layers[3] = { view.size[0], view.size[1], depth + 1 };
+      textures.intensity = std::make_unique<cuda::Texture3D>(pairs.data(), 2 * sizeof(std::uint16_t),
+                                                             cudaCreateChannelDesc<ushort2>(), layers,
+                                                             cuda::TextureLayout::Layers);
       view.intensityTexture = static_cast<unsigned long long>(textures.intensity->Get());
       const std::size_t structures = volume.channels - 1;
       if (structures > 0)

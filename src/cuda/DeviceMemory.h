@@ -149,14 +149,24 @@ private:
 };
 /** A 3D texture with trilinear filtering (clamped, unnormalised
  *  coordinates), owning its array. `voxels` holds `bytesPerVoxel` bytes per
- *  voxel in `format`; integer formats read as normalised floats. */
+ *  voxel in `format`; integer formats read as normalised floats. With
+ *  `TextureLayout::Layers`, size[2] counts 2D layers, each filtered
+ *  bilinearly on its own (tex2DLayered). */
+enum class TextureLayout
+{
+  Volume,
+  Layers
+};
+
 class Texture3D
 {
 public:
-  Texture3D(const void * voxels, std::size_t bytesPerVoxel, const cudaChannelFormatDesc & format, const int size[3])
+  Texture3D(const void * voxels, std::size_t bytesPerVoxel, const cudaChannelFormatDesc & format, const int size[3],
+            TextureLayout layout = TextureLayout::Volume)
   {
     const cudaExtent extent = make_cudaExtent(size[0], size[1], size[2]);
-    Check(cudaMalloc3DArray(&m_Array, &format, extent), "allocating a texture array");
+    Check(cudaMalloc3DArray(&m_Array, &format, extent, layout == TextureLayout::Layers ? cudaArrayLayered : 0),
+          "allocating a texture array");
     cudaMemcpy3DParms copy{};
     copy.srcPtr = make_cudaPitchedPtr(const_cast<void *>(voxels), size[0] * bytesPerVoxel, size[0], size[1]);
     copy.dstArray = m_Array;

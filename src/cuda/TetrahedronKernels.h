@@ -23,7 +23,7 @@ struct VolumeView
 enum class Interpolation
 {
   Exact,   ///< trilinear in software from 16-byte loads, weights as on the CPU (agrees to rounding)
-  Texture  ///< the texture units' trilinear filtering (9-bit weights: faster, not bit-comparable)
+  Texture  ///< the texture units' filtering (8-bit weights across x and y: faster, not bit-comparable)
 };
 
 /** A volume with at most 4 channels. Exact: channels padded to 4, float4
@@ -34,7 +34,7 @@ enum class Interpolation
 struct PackedVolumeView
 {
   const void *       data{ nullptr };            ///< Exact: float4 per voxel
-  unsigned long long intensityTexture{ 0 };      ///< Texture: cudaTextureObject_t
+  unsigned long long intensityTexture{ 0 };      ///< Texture: cudaTextureObject_t, slice pairs (SlicePairTrilinear)
   unsigned long long distanceTexture{ 0 };       ///< Texture: cudaTextureObject_t (0: no structures)
   int                distanceChannels{ 0 };      ///< Texture: 1, 2 or 4
   /** Texture: per block of NearBlockSize^3 texels (x fastest) one bit
