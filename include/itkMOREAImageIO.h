@@ -45,6 +45,10 @@ ValidateImage(const ImageBase<Dimension> * image, const std::string & what);
 void
 ValidateVoxels(const ImageType * image, const std::string & what);
 
+/** The number of non-zero voxels in the mask's buffer. */
+std::size_t
+CountInside(const MaskType * mask);
+
 /** Checks that two images describe the same voxel grid (size, spacing, origin,
  *  direction) to within `tolerance` (relative to spacing). */
 bool

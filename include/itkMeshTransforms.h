@@ -19,6 +19,7 @@
 #include "morea/TetrahedralMesh.h"
 #include "morea/VtuWriter.h"
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -62,9 +63,20 @@ public:
   DisplacementVectorType
   VectorToPhysical(const ::morea::Vec3 & frame) const;
 
-  /** The grid of `grid` (its largest possible region) as an axis-aligned core
-   *  displacement volume in this frame, filled with zeros. Throws unless the
-   *  grid is aligned with the frame. */
+  /** The grid of `grid` (its largest possible region) in this frame: voxels
+   *  per axis, spacing, and the first voxel's centre. Throws unless the grid
+   *  is aligned with the frame. */
+  struct GridGeometry
+  {
+    std::array<std::size_t, 3> size{ { 0, 0, 0 } };
+    ::morea::Vec3              spacing{ { 1.0, 1.0, 1.0 } };
+    ::morea::Vec3              origin{ { 0.0, 0.0, 0.0 } };
+  };
+  GridGeometry
+  GeometryOf(const ImageBase<Dimension> * grid) const;
+
+  /** The same grid as an axis-aligned core displacement volume, filled with
+   *  zeros. */
   ::morea::Volume<::morea::Vec3>
   FieldGridOf(const ImageBase<Dimension> * grid) const;
 

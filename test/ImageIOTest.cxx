@@ -251,6 +251,11 @@ TEST(ImageIO, MaskRoundTripAndNonZeroIsInside)
   for (itk::ImageRegionConstIterator<MaskType> it(binary, binary->GetLargestPossibleRegion()); !it.IsAtEnd(); ++it)
     inside += it.Get();
   EXPECT_EQ(inside, 3u);
+  EXPECT_EQ(CountInside(binary), 3u);
+  // Any non-zero mask value counts, the first and the last voxel included.
+  mask->SetPixel({ { 0, 0, 0 } }, 255);
+  mask->SetPixel({ { 7, 7, 3 } }, 2);
+  EXPECT_EQ(CountInside(mask), 4u);
 }
 
 TEST(ImageIO, DisplacementFieldRoundTrip)

@@ -31,10 +31,11 @@ struct MeshDomain
   Vec3 lower{ { 0.0, 0.0, 0.0 } };
   Vec3 upper{ { 0.0, 0.0, 0.0 } };
 
-  /** The box spanned by the voxel centres of `grid`. */
-  template <typename T>
+  /** The box spanned by the voxel centres of `grid` (a Volume, or any grid
+   *  with its size, spacing and origin). */
+  template <typename TGrid>
   static MeshDomain
-  OfGrid(const Volume<T> & grid)
+  OfGrid(const TGrid & grid)
   {
     MeshDomain d;
     for (int a = 0; a < 3; ++a)

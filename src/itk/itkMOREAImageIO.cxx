@@ -249,19 +249,28 @@ ValidateImage(const ImageBase<Dimension> * image, const std::string & what)
 void
 ValidateVoxels(const ImageType * image, const std::string & what)
 {
-  std::size_t bad = 0;
-  ImageRegionConstIterator<ImageType> it(image, image->GetBufferedRegion());
-  for (; !it.IsAtEnd(); ++it)
-  {
-    if (!std::isfinite(it.Get()))
-    {
-      ++bad;
-    }
-  }
+  // The buffer directly: an iterator per voxel took a quarter of a second
+  // on the abdominal pair's masks and images.
+  const float *     voxels = image->GetBufferPointer();
+  const std::size_t count = image->GetBufferedRegion().GetNumberOfPixels();
+  std::size_t       bad = 0;
+  for (std::size_t v = 0; v < count; ++v)
+    bad += std::isfinite(voxels[v]) ? 0 : 1;
   if (bad > 0)
   {
     Fail(what + ": " + std::to_string(bad) + " voxels are NaN or infinite");
   }
+}
+
+std::size_t
+CountInside(const MaskType * mask)
+{
+  const MaskType::PixelType * voxels = mask->GetBufferPointer();
+  const std::size_t           count = mask->GetBufferedRegion().GetNumberOfPixels();
+  std::size_t                 inside = 0;
+  for (std::size_t v = 0; v < count; ++v)
+    inside += voxels[v] != 0 ? 1 : 0;
+  return inside;
 }
 
 bool
@@ -317,16 +326,16 @@ ReadMask(const std::string & path)
   ValidateVoxels(raw, "mask '" + path + "'");
   auto mask = MaskType::New();
   mask->CopyInformation(raw);
-  mask->SetRegions(raw->GetLargestPossibleRegion());
+  mask->SetRegions(raw->GetBufferedRegion()); // a reader's buffer is its whole image
   mask->Allocate();
-  std::size_t inside = 0;
-  ImageRegionConstIterator<ImageType> in(raw, raw->GetLargestPossibleRegion());
-  ImageRegionIterator<MaskType>       out(mask, mask->GetLargestPossibleRegion());
-  for (; !in.IsAtEnd(); ++in, ++out)
+  const float *       in = raw->GetBufferPointer();
+  MaskType::PixelType * out = mask->GetBufferPointer();
+  const std::size_t   count = raw->GetBufferedRegion().GetNumberOfPixels();
+  std::size_t         inside = 0;
+  for (std::size_t v = 0; v < count; ++v)
   {
-    const bool on = in.Get() != 0.0f;
-    out.Set(on ? 1 : 0);
-    inside += on;
+    out[v] = in[v] != 0.0f ? 1 : 0;
+    inside += out[v];
   }
   if (inside == 0)
   {
@@ -338,18 +347,22 @@ ReadMask(const std::string & path)
 MaskType::Pointer
 ExtractLabel(const LabelMapType * labelMap, unsigned int label, const std::string & what)
 {
+  if (labelMap->GetBufferedRegion() != labelMap->GetLargestPossibleRegion())
+  {
+    Fail(what + ": the label map is not wholly in memory");
+  }
   auto mask = MaskType::New();
   mask->CopyInformation(labelMap);
   mask->SetRegions(labelMap->GetLargestPossibleRegion());
   mask->Allocate();
-  std::size_t inside = 0;
-  ImageRegionConstIterator<LabelMapType> in(labelMap, labelMap->GetLargestPossibleRegion());
-  ImageRegionIterator<MaskType>          out(mask, mask->GetLargestPossibleRegion());
-  for (; !in.IsAtEnd(); ++in, ++out)
+  const LabelMapType::PixelType * in = labelMap->GetBufferPointer();
+  MaskType::PixelType *           out = mask->GetBufferPointer();
+  const std::size_t               count = labelMap->GetBufferedRegion().GetNumberOfPixels();
+  std::size_t                     inside = 0;
+  for (std::size_t v = 0; v < count; ++v)
   {
-    const bool on = in.Get() == label;
-    out.Set(on ? 1 : 0);
-    inside += on;
+    out[v] = in[v] == label ? 1 : 0;
+    inside += out[v];
   }
   if (inside == 0)
   {

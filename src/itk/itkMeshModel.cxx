@@ -61,8 +61,7 @@ BuildMeshModel(const RegistrationProblem & problem, const ::morea::ParameterSet 
     itkGenericExceptionMacro("mesh model: the problem must be preprocessed (both images on one grid)");
   MeshModel model;
   model.frame = DomainFrame::Of(problem.movingImage);
-  ::morea::Volume<::morea::Vec3> grid = model.frame.FieldGridOf(problem.movingImage);
-  const ::morea::MeshDomain      domain = ::morea::MeshDomain::OfGrid(grid);
+  const ::morea::MeshDomain domain = ::morea::MeshDomain::OfGrid(model.frame.GeometryOf(problem.movingImage));
 
   // The mesh lies on the moving (source) image: its structures' contours and masks.
   auto                                       start = Clock::now();

@@ -33,7 +33,7 @@ ToFrameVolume(const TImage * image, const DomainFrame & frame, const char * what
   {
     itkGenericExceptionMacro(<< "cannot convert a partly buffered " << what);
   }
-  const auto              geometry = frame.FieldGridOf(image);
+  const auto              geometry = frame.GeometryOf(image);
   ::morea::Volume<TValue> volume(geometry.size, geometry.spacing, geometry.origin);
   const auto *            buffer = image->GetBufferPointer();
   // ITK's buffer order is the core's: x fastest, then y, then z.
@@ -153,8 +153,8 @@ DomainFrame::VectorToPhysical(const ::morea::Vec3 & frame) const
   return v;
 }
 
-::morea::Volume<::morea::Vec3>
-DomainFrame::FieldGridOf(const ImageBase<Dimension> * grid) const
+DomainFrame::GridGeometry
+DomainFrame::GeometryOf(const ImageBase<Dimension> * grid) const
 {
   if (grid == nullptr)
   {
@@ -165,18 +165,25 @@ DomainFrame::FieldGridOf(const ImageBase<Dimension> * grid) const
     itkGenericExceptionMacro(<< "the image grid's direction " << grid->GetDirection() << " is not the domain frame's "
                              << m_Direction);
   }
-  const auto                 region = grid->GetLargestPossibleRegion();
-  std::array<std::size_t, 3> size;
-  ::morea::Vec3              spacing;
+  const auto   region = grid->GetLargestPossibleRegion();
+  GridGeometry geometry;
   for (unsigned d = 0; d < Dimension; ++d)
   {
-    size[d] = region.GetSize()[d];
-    spacing[d] = grid->GetSpacing()[d];
+    geometry.size[d] = region.GetSize()[d];
+    geometry.spacing[d] = grid->GetSpacing()[d];
   }
   // The region may start at a non-zero index: the core's first voxel is that one.
   PointType first;
   grid->TransformIndexToPhysicalPoint(region.GetIndex(), first);
-  return ::morea::Volume<::morea::Vec3>(size, spacing, ToFrame(first));
+  geometry.origin = ToFrame(first);
+  return geometry;
+}
+
+::morea::Volume<::morea::Vec3>
+DomainFrame::FieldGridOf(const ImageBase<Dimension> * grid) const
+{
+  const GridGeometry geometry = GeometryOf(grid);
+  return ::morea::Volume<::morea::Vec3>(geometry.size, geometry.spacing, geometry.origin);
 }
 
 ImageType::Pointer

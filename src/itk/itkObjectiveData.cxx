@@ -43,16 +43,6 @@ MakeImageOn(const ImageBase<Dimension> * grid)
   return image;
 }
 
-std::size_t
-CountInside(const MaskType * mask)
-{
-  std::size_t n = 0;
-  for (ImageRegionConstIterator<MaskType> it(mask, mask->GetBufferedRegion()); !it.IsAtEnd(); ++it)
-  {
-    n += it.Get() != 0;
-  }
-  return n;
-}
 
 /** Distance (mm) from every voxel centre outside `set` to the nearest voxel
  *  centre of `set`, 0 on the set. Only the outside of Maurer's signed map is

@@ -28,15 +28,6 @@ Fail(const std::string & message)
   itkGenericExceptionMacro(<< message);
 }
 
-std::size_t
-CountInside(const MaskType * mask)
-{
-  std::size_t                        n = 0;
-  ImageRegionConstIterator<MaskType> it(mask, mask->GetBufferedRegion());
-  for (; !it.IsAtEnd(); ++it)
-    n += it.Get() != 0;
-  return n;
-}
 
 /** Index box of the non-zero voxels; false when there are none. Rows are
  *  scanned in the buffer from both ends: an iterator that tracks every

@@ -65,15 +65,6 @@ SplitSource(const std::string & source, std::string & path, std::string & select
     Fail("structure source '" + path + "' does not exist");
 }
 
-std::size_t
-CountInside(const MaskType * mask)
-{
-  std::size_t                           n = 0;
-  ImageRegionConstIterator<MaskType> it(mask, mask->GetLargestPossibleRegion());
-  for (; !it.IsAtEnd(); ++it)
-    n += it.Get() != 0;
-  return n;
-}
 
 const char *
 SideName(bool fixedSide)
