@@ -3,6 +3,7 @@
 // falls in an unmarked block (the CUDA sampling skips its distance fetch
 // there).
 #include "morea/NearContourBlocks.h"
+#include "morea/Error.h"
 #include "morea/ObjectiveData.h"
 #include "morea/Random.h"
 
@@ -55,25 +56,29 @@ TEST(NearContourBlocks, MarksTheBlocksWhoseFootprintsReachBelowTheRadius)
 
   // Brute force: voxels [4 b, 4 b + 4] per axis, clamped to the grid.
   constexpr int B = NearContourBlocks::BlockSize;
-  std::size_t   marked = 0;
+  std::size_t   marked = 0, both = 0;
   for (int bz = 0; bz < near.blocks[2]; ++bz)
     for (int by = 0; by < near.blocks[1]; ++by)
       for (int bx = 0; bx < near.blocks[0]; ++bx)
       {
-        float nearest = 1e30f;
+        float nearest[2] = { 1e30f, 1e30f };
         for (std::size_t z = B * bz; z <= std::min<std::size_t>(B * bz + B, volume.size[2] - 1); ++z)
           for (std::size_t y = B * by; y <= std::min<std::size_t>(B * by + B, volume.size[1] - 1); ++y)
             for (std::size_t x = B * bx; x <= std::min<std::size_t>(B * bx + B, volume.size[0] - 1); ++x)
             {
               const std::size_t v = x + volume.size[0] * (y + volume.size[1] * z);
-              nearest = std::min({ nearest, volume.data[3 * v + 1], volume.data[3 * v + 2] });
+              for (int g = 0; g < 2; ++g)
+                nearest[g] = std::min(nearest[g], volume.data[3 * v + 1 + g]);
             }
         const std::size_t block = bx + near.blocks[0] * (by + near.blocks[1] * static_cast<std::size_t>(bz));
-        EXPECT_EQ(near.mask[block], nearest < radius ? 1 : 0) << "block " << bx << " " << by << " " << bz;
-        marked += near.mask[block];
+        const int expected = (nearest[0] < radius ? 1 : 0) | (nearest[1] < radius ? 2 : 0);
+        EXPECT_EQ(near.mask[block], expected) << "block " << bx << " " << by << " " << bz;
+        marked += near.mask[block] != 0;
+        both += near.mask[block] == 3;
       }
   EXPECT_GT(marked, 2u);
   EXPECT_LT(marked, near.mask.size() / 2) << "most blocks are far from both points";
+  EXPECT_LT(both, marked) << "blocks near one point only";
 }
 
 TEST(NearContourBlocks, NoInterpolatedDistanceBelowTheRadiusFallsInAnUnmarkedBlock)
@@ -95,13 +100,13 @@ TEST(NearContourBlocks, NoInterpolatedDistanceBelowTheRadiusFallsInAnUnmarkedBlo
     }
     float values[3];
     volume.Sample(p, values);
-    const bool inside = std::min(values[1], values[2]) < radius;
-    const bool marked = near.mask[near.BlockOf(x)] != 0;
-    within += inside;
-    skipped += !marked;
-    if (inside)
-      ASSERT_TRUE(marked) << "sample at " << x[0] << " " << x[1] << " " << x[2] << " distance "
-                          << std::min(values[1], values[2]);
+    const std::uint8_t bits = near.mask[near.BlockOf(x)];
+    within += std::min(values[1], values[2]) < radius;
+    skipped += bits == 0;
+    for (int g = 0; g < 2; ++g)
+      if (values[1 + g] < radius)
+        ASSERT_TRUE((bits >> g) & 1u) << "sample at " << x[0] << " " << x[1] << " " << x[2] << " distance "
+                                      << values[1 + g] << " to structure " << g;
   }
   EXPECT_GT(within, 1000u);
   EXPECT_GT(skipped, 50000u) << "most samples need no distance";
@@ -116,4 +121,16 @@ TEST(NearContourBlocks, NoStructuresMarkNothing)
   const NearContourBlocks near = FindNearContourBlocks(volume, 3.0);
   EXPECT_EQ(near.mask.size(), 27u);
   EXPECT_EQ(std::count(near.mask.begin(), near.mask.end(), 1), 0);
+}
+
+TEST(NearContourBlocks, AtMostEightStructures)
+{
+  ChannelVolume volume;
+  volume.size = { { 2, 2, 2 } };
+  volume.channels = 10;
+  volume.data.assign(80, 1.0f);
+  EXPECT_THROW(FindNearContourBlocks(volume, 3.0), Error);
+  volume.channels = 9;
+  volume.data.assign(72, 1.0f);
+  EXPECT_EQ(FindNearContourBlocks(volume, 3.0).mask[0], 0xff);
 }

@@ -23,7 +23,9 @@ struct NearContourBlocks
   static constexpr int BlockSize = 4;
 
   std::array<int, 3>        blocks{ { 0, 0, 0 } }; ///< per axis, ceil(size / BlockSize)
-  std::vector<std::uint8_t> mask;                  ///< per block, x fastest: 1 = may be near
+  /** Per block, x fastest: bit g set where structure g may be near (0:
+   *  near none). */
+  std::vector<std::uint8_t> mask;
 
   /** The block of continuous voxel index `x` (voxel centres at integers):
    *  the one holding the first voxel of its trilinear footprint, floor(x),
@@ -44,11 +46,13 @@ struct NearContourBlocks
 };
 
 /** Marks each block of `volume` (channel 0 the intensity, then one distance
- *  map per structure, in mm) in which any voxel that a trilinear sample
- *  starting in the block reads, [BlockSize b, BlockSize b + BlockSize] per
- *  axis, has a distance below `radius` (plus a margin for rounding). An
- *  interpolated distance is never below the smallest of its voxels, so a
- *  sample in an unmarked block is at least `radius` from every contour. */
+ *  map per structure, in mm; at most 8 structures) with bit g where any
+ *  voxel that a trilinear sample starting in the block reads, [BlockSize b,
+ *  BlockSize b + BlockSize] per axis, has a distance to structure g below
+ *  `radius` (plus a margin for rounding). An interpolated distance is never
+ *  below the smallest of its voxels, so a sample in a block without bit g is
+ *  at least `radius` from structure g's contour. Throws for more than 8
+ *  structures. */
 NearContourBlocks
 FindNearContourBlocks(const ChannelVolume & volume, double radius);
 } // namespace morea

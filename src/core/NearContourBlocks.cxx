@@ -1,5 +1,6 @@
 #include "morea/NearContourBlocks.h"
 
+#include "morea/Error.h"
 #include "morea/ObjectiveData.h"
 
 #include <algorithm>
@@ -18,6 +19,8 @@ FindNearContourBlocks(const ChannelVolume & volume, double radius)
     n[a] = (volume.size[a] + B - 1) / B;
     out.blocks[a] = static_cast<int>(n[a]);
   }
+  if (volume.channels > 9)
+    throw Error("near-contour blocks: at most 8 structures");
   out.mask.assign(n[0] * n[1] * n[2], 0);
   // The texture filter rounds its weights and sums in single precision.
   const double limit = radius * (1.0 + 1e-5) + 1e-6;
@@ -26,10 +29,11 @@ FindNearContourBlocks(const ChannelVolume & volume, double radius)
     for (std::size_t y = 0; y < volume.size[1]; ++y)
       for (std::size_t x = 0; x < volume.size[0]; ++x, ++v)
       {
-        float nearest = std::numeric_limits<float>::infinity();
+        std::uint8_t structures = 0;
         for (std::size_t g = 1; g < volume.channels; ++g)
-          nearest = std::min(nearest, volume.data[volume.channels * v + g]);
-        if (!(nearest < limit))
+          if (volume.data[volume.channels * v + g] < limit)
+            structures |= static_cast<std::uint8_t>(1u << (g - 1));
+        if (structures == 0)
           continue;
         // Voxel i lies in the ranges of block i / B and, on a block's first
         // voxel, of the block before.
@@ -43,7 +47,7 @@ FindNearContourBlocks(const ChannelVolume & volume, double radius)
         for (std::size_t bz = from[2]; bz <= to[2]; ++bz)
           for (std::size_t by = from[1]; by <= to[1]; ++by)
             for (std::size_t bx = from[0]; bx <= to[0]; ++bx)
-              out.mask[(bz * n[1] + by) * n[0] + bx] = 1;
+              out.mask[(bz * n[1] + by) * n[0] + bx] |= structures;
       }
   return out;
 }

@@ -52,7 +52,8 @@ constexpr double ChunkRoomMargin = 1.25;
 /** The texture path's textures of one image. */
 struct VolumeTextures
 {
-  std::unique_ptr<cuda::Texture3D> intensity, distance;
+  std::unique_ptr<cuda::Texture3D>                                     intensity;
+  std::array<std::unique_ptr<cuda::Texture3D>, cuda::MaxTextureStructures> distances;
   cuda::DeviceArray<std::uint8_t>  nearBlocks; ///< see cuda::PackedVolumeView::nearBlocks
 };
 
@@ -706,24 +707,26 @@ private:
       const std::size_t structures = volume.channels - 1;
       if (structures > 0)
       {
-        const int          channels = structures == 1 ? 1 : (structures == 2 ? 2 : 4);
-        // Padding channels hold a distance no radius reaches. (16-bit
-        // normalised distance texels measured 11 % slower on an H100.)
-        std::vector<float> distance(channels * voxels, 3.0e38f);
-        for (std::size_t v = 0; v < voxels; ++v)
-          for (std::size_t g = 0; g < structures; ++g)
-            distance[channels * v + g] = volume.data[volume.channels * v + 1 + g];
-        const cudaChannelFormatDesc format = cudaCreateChannelDesc(32, channels > 1 ? 32 : 0, channels > 2 ? 32 : 0,
-                                                                   channels > 2 ? 32 : 0, cudaChannelFormatKindFloat);
-        textures.distance =
-          std::make_unique<cuda::Texture3D>(distance.data(), channels * sizeof(float), format, view.size);
-        view.distanceTexture = static_cast<unsigned long long>(textures.distance->Get());
-        view.distanceChannels = channels;
+        if (structures > static_cast<std::size_t>(cuda::MaxTextureStructures))
+          throw Error("CUDA backend: the texture path reads at most 3 guidance structures");
+        // One float map per structure. (16-bit normalised distance texels
+        // measured 11 % slower on an H100.)
+        std::vector<float> distance(voxels);
+        for (std::size_t g = 0; g < structures; ++g)
+        {
+          for (std::size_t v = 0; v < voxels; ++v)
+            distance[v] = volume.data[volume.channels * v + 1 + g];
+          textures.distances[g] =
+            std::make_unique<cuda::Texture3D>(distance.data(), sizeof(float), cudaCreateChannelDesc<float>(), view.size);
+          view.distanceTextures[g] = static_cast<unsigned long long>(textures.distances[g]->Get());
+        }
+        view.distanceMaps = static_cast<int>(structures);
         const NearContourBlocks near = FindNearContourBlocks(volume, m_Constants.guidanceRadius);
-        // One bit per block, so that the mask stays small enough for L1.
-        std::vector<std::uint8_t> bits((near.mask.size() + 7) / 8, 0);
+        // Four bits per block (a structure each), so that the mask stays
+        // small enough for L1.
+        std::vector<std::uint8_t> bits((near.mask.size() + 1) / 2, 0);
         for (std::size_t b = 0; b < near.mask.size(); ++b)
-          bits[b / 8] |= static_cast<std::uint8_t>((near.mask[b] != 0 ? 1u : 0u) << (b % 8));
+          bits[b / 2] |= static_cast<std::uint8_t>((near.mask[b] & 0x0fu) << (4 * (b % 2)));
         textures.nearBlocks.Reserve(bits.size());
         Check(cudaMemcpy(textures.nearBlocks.Data(), bits.data(), bits.size(), cudaMemcpyHostToDevice),
               "uploading the near-contour blocks");

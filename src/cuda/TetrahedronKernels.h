@@ -31,21 +31,29 @@ enum class Interpolation
  *  texels (2 bytes: small footprint, many samples per cache line) and the
  *  distance maps in a float texture of their own (1, 2 or 4 channels), read
  *  only near a contour. */
+/** Structures whose distances the texture path reads (the packed kernels
+ *  read 4 channels per voxel: intensity and up to 3 distances). */
+constexpr int MaxTextureStructures = 3;
+
 struct PackedVolumeView
 {
   const void *       data{ nullptr };            ///< Exact: float4 per voxel
   unsigned long long intensityTexture{ 0 };      ///< Texture: cudaTextureObject_t, slice pairs (SlicePairTrilinear)
-  unsigned long long distanceTexture{ 0 };       ///< Texture: cudaTextureObject_t (0: no structures)
-  int                distanceChannels{ 0 };      ///< Texture: 1, 2 or 4
-  /** Texture: per block of NearBlockSize^3 texels (x fastest) one bit
-   *  (bit b % 8 of byte b / 8), set where a sample whose trilinear
-   *  footprint starts in the block may lie within the guidance radius of a
-   *  contour: the smallest distance of the texels it can read is below the
-   *  radius (an interpolated value is never below its texels' minimum).
-   *  Null without structures. A bit rather than a byte per block: 4 KB for
-   *  the paper's abdomen pair, which L1 keeps; late generations' kernels on
-   *  an H100 took 0.0898 s per generation against 0.0911 s with bytes (and
-   *  0.0907 s with bits for blocks of 2 texels, 0.0952 s with bytes). */
+  /** Texture: one float texture per structure (cudaTextureObject_t; 0
+   *  past distanceMaps): half the bytes of a multi-channel texel where, as
+   *  mostly, a sample is near one structure only. */
+  unsigned long long distanceTextures[MaxTextureStructures]{ 0, 0, 0 };
+  int                distanceMaps{ 0 }; ///< Texture: structures (0: none)
+  /** Texture: per block of NearBlockSize^3 texels (x fastest) 4 bits (of
+   *  byte b / 2, the low ones for even b), bit g set where a sample whose
+   *  trilinear footprint starts in the block may lie within the guidance
+   *  radius of structure g's contour: the smallest distance of the texels it
+   *  can read is below the radius (an interpolated value is never below its
+   *  texels' minimum). Null without structures. Bits rather than a byte per
+   *  block keep the mask small enough for L1 (9 KB for the paper's abdomen
+   *  pair); with one bit per block for all structures, late generations'
+   *  kernels on an H100 took 0.0898 s per generation against 0.0911 s with
+   *  bytes. */
   const std::uint8_t * nearBlocks{ nullptr };
   int                  blocks[3]{ 0, 0, 0 };
   int                size[3]{ 0, 0, 0 };

@@ -162,22 +162,6 @@ TexelCorners(const PackedVolumeView & image, const double c[12], float out[12])
   }
 }
 
-/** Distance maps at texel position `x` (channels 1, 2 or 4, padded to 4 with
- *  a distance no radius reaches). */
-__device__ float4
-Distances(cudaTextureObject_t texture, int channels, float x, float y, float z)
-{
-  constexpr float far = 3.0e38f;
-  if (channels == 1)
-    return make_float4(tex3D<float>(texture, x, y, z), far, far, far);
-  if (channels == 2)
-  {
-    const float2 d = tex3D<float2>(texture, x, y, z);
-    return make_float4(d.x, d.y, far, far);
-  }
-  return tex3D<float4>(texture, x, y, z);
-}
-
 __device__ void
 PrepareDirection(const EvaluationConstants & k, const double from[12], const double to[12],
                  const PackedVolumeView & fromImage, const PackedVolumeView & toImage, SampleTask & task)
@@ -193,7 +177,7 @@ PrepareDirection(const EvaluationConstants & k, const double from[12], const dou
   // tetrahedron whose centre is farther than radius + 2 x (its largest
   // centre-corner distance) + a rounding margin has no such sample.
   task.nearContour = 0;
-  if (fromImage.distanceTexture == 0)
+  if (fromImage.distanceMaps == 0)
     return;
   double centre[3] = { 0.0, 0.0, 0.0 }, reach = 0.0, spacing = 0.0;
   for (int a = 0; a < 3; ++a)
@@ -209,9 +193,10 @@ PrepareDirection(const EvaluationConstants & k, const double from[12], const dou
   float t[3];
   for (int a = 0; a < 3; ++a)
     t[a] = static_cast<float>((centre[a] - fromImage.origin[a]) * fromImage.inverseSpacing[a]) + 0.5f;
-  const float4 d = Distances(static_cast<cudaTextureObject_t>(fromImage.distanceTexture), fromImage.distanceChannels,
-                             t[0], t[1], t[2]);
-  const double nearest = fmin(fmin(d.x, d.y), fmin(d.z, d.w));
+  double nearest = INFINITY;
+  for (int g = 0; g < fromImage.distanceMaps; ++g)
+    nearest = fmin(nearest, static_cast<double>(tex3D<float>(
+                              static_cast<cudaTextureObject_t>(fromImage.distanceTextures[g]), t[0], t[1], t[2])));
   const double margin = 0.02 * spacing + 1e-4 * fabs(nearest);
   task.nearContour = nearest - 2.0 * reach - margin < k.guidanceRadius ? 1u : 0u;
 }
@@ -258,12 +243,6 @@ PrepareTextureTasks(EvaluationConstants k, const double * __restrict__ corners,
   o[2] = folded;
 }
 
-__device__ float
-Component(const float4 & v, int c)
-{
-  return c == 0 ? v.x : (c == 1 ? v.y : (c == 2 ? v.z : v.w));
-}
-
 /** Trilinear interpolation at texel position (x, y, z) of an intensity
  *  texture of slice pairs (layer l: slices l - 1 and l, clamped; see
  *  UploadPacked): slice k's centre lies at z = k + 1/2, so the pair around z
@@ -288,11 +267,11 @@ SlicePairTrilinear(cudaTextureObject_t pairs, int depth, float x, float y, float
 /** What the sampling kernel needs besides the tasks, by value. */
 struct SamplingConstants
 {
-  cudaTextureObject_t movingIntensity, fixedIntensity, movingDistance, fixedDistance;
+  cudaTextureObject_t movingIntensity, fixedIntensity;
+  cudaTextureObject_t movingDistances[MaxTextureStructures], fixedDistances[MaxTextureStructures];
   const std::uint8_t *movingNearBlocks, *fixedNearBlocks; ///< see PackedVolumeView::nearBlocks
   int                 movingBlocks[3], fixedBlocks[3];
   int                 movingDepth, fixedDepth; ///< slices of each image (its top layer)
-  int                 distanceChannels;
   float               guidanceWeights[3];
   float               radius, inverseRadius;
   int                 structures;
@@ -333,19 +312,20 @@ ScatterChunkTasks(const std::uint32_t * __restrict__ sortedItems, const std::uin
     chunkTask[c] = task;
 }
 
-/** Whether the distance at texel position `p` may be below the guidance
- *  radius (PackedVolumeView::nearBlocks). The block of the footprint's
- *  first texel floor(p - 1/2), clamped as the texture clamps: the rule of
- *  morea::NearContourBlocks::BlockOf, in texel coordinates. */
-__device__ bool
-MayBeNearContour(const std::uint8_t * __restrict__ nearBlocks, const int blocks[3], const float p[3])
+/** The structures whose distance at texel position `p` may be below the
+ *  guidance radius (PackedVolumeView::nearBlocks: bit g for structure g).
+ *  The block of the footprint's first texel floor(p - 1/2), clamped as the
+ *  texture clamps: the rule of morea::NearContourBlocks::BlockOf, in texel
+ *  coordinates. */
+__device__ unsigned
+NearStructures(const std::uint8_t * __restrict__ nearBlocks, const int blocks[3], const float p[3])
 {
   int b[3];
 #pragma unroll
   for (int a = 0; a < 3; ++a)
     b[a] = min(max(__float2int_rd((p[a] - 0.5f) * (1.0f / NearBlockSize)), 0), blocks[a] - 1);
   const std::size_t block = (static_cast<std::size_t>(b[2]) * blocks[1] + b[1]) * blocks[0] + b[0];
-  return ((__ldg(nearBlocks + block / 8) >> (block % 8)) & 1u) != 0;
+  return (__ldg(nearBlocks + block / 2) >> (4 * (block % 2))) & 0x0fu;
 }
 
 /** Adds one sample's terms; `state`: its Sobol state (shift included). */
@@ -359,8 +339,6 @@ SamplePoint(const SamplingConstants & k, const float4 * corners, bool near, cons
   // fetch was wrapped in a loop over the warp's distinct objects).
   const cudaTextureObject_t fromIntensity = Direction == 0 ? k.movingIntensity : k.fixedIntensity;
   const cudaTextureObject_t toIntensity = Direction == 0 ? k.fixedIntensity : k.movingIntensity;
-  const cudaTextureObject_t fromDistance = Direction == 0 ? k.movingDistance : k.fixedDistance;
-  const cudaTextureObject_t toDistance = Direction == 0 ? k.fixedDistance : k.movingDistance;
   const std::uint8_t *      fromNearBlocks = Direction == 0 ? k.movingNearBlocks : k.fixedNearBlocks;
   const int *               fromBlocks = Direction == 0 ? k.movingBlocks : k.fixedBlocks;
   float                     w[4], sum = 0.0f;
@@ -391,28 +369,25 @@ SamplePoint(const SamplingConstants & k, const float4 * corners, bool near, cons
   }
   else if (a > 0.0f || b > 0.0f)
     intensity += 1.0f;
-  // The sampled distance only where the sample's block may be within
-  // the radius (a bit read mostly from L1 instead of a filtered fetch),
-  // the mapped one only where the sampled one is: most samples of a task
-  // near a contour are not.
-  if (near && MayBeNearContour(fromNearBlocks, fromBlocks, p))
+  // A structure's sampled distance only where the sample's block may be
+  // within the radius of its contour (bits read mostly from L1 instead of
+  // a filtered fetch), the mapped one only where the sampled one is: most
+  // samples of a task near a contour are not, and few are near two.
+  if (near)
   {
-    const float4 da = Distances(fromDistance, k.distanceChannels, p[0], p[1], p[2]);
-    if (fminf(fminf(da.x, da.y), fminf(da.z, da.w)) < k.radius)
-    {
-      const float4 db = Distances(toDistance, k.distanceChannels, r[0], r[1], r[2]);
+    const unsigned structures = NearStructures(fromNearBlocks, fromBlocks, p);
 #pragma unroll
-      for (int g = 0; g < 3; ++g)
-        if (g < k.structures)
+    for (int g = 0; g < MaxTextureStructures; ++g)
+      if ((structures >> g) & 1u)
+      {
+        const float d = tex3D<float>(Direction == 0 ? k.movingDistances[g] : k.fixedDistances[g], p[0], p[1], p[2]);
+        if (d < k.radius)
         {
-          const float d = Component(da, g);
-          if (d < k.radius)
-          {
-            const float e = d - Component(db, g);
-            guidance += k.guidanceWeights[g] * (k.radius - d) * k.inverseRadius * e * e;
-          }
+          const float e =
+            d - tex3D<float>(Direction == 0 ? k.fixedDistances[g] : k.movingDistances[g], r[0], r[1], r[2]);
+          guidance += k.guidanceWeights[g] * (k.radius - d) * k.inverseRadius * e * e;
         }
-    }
+      }
   }
 }
 
@@ -686,8 +661,11 @@ SamplingConstantsOf(const EvaluationConstants & constants)
   SamplingConstants k;
   k.movingIntensity = static_cast<cudaTextureObject_t>(constants.packedMoving.intensityTexture);
   k.fixedIntensity = static_cast<cudaTextureObject_t>(constants.packedFixed.intensityTexture);
-  k.movingDistance = static_cast<cudaTextureObject_t>(constants.packedMoving.distanceTexture);
-  k.fixedDistance = static_cast<cudaTextureObject_t>(constants.packedFixed.distanceTexture);
+  for (int g = 0; g < MaxTextureStructures; ++g)
+  {
+    k.movingDistances[g] = static_cast<cudaTextureObject_t>(constants.packedMoving.distanceTextures[g]);
+    k.fixedDistances[g] = static_cast<cudaTextureObject_t>(constants.packedFixed.distanceTextures[g]);
+  }
   k.movingNearBlocks = constants.packedMoving.nearBlocks;
   k.fixedNearBlocks = constants.packedFixed.nearBlocks;
   for (int a = 0; a < 3; ++a)
@@ -697,7 +675,6 @@ SamplingConstantsOf(const EvaluationConstants & constants)
   }
   k.movingDepth = constants.packedMoving.size[2];
   k.fixedDepth = constants.packedFixed.size[2];
-  k.distanceChannels = constants.packedMoving.distanceChannels;
   for (int g = 0; g < 3; ++g)
     k.guidanceWeights[g] = constants.textureGuidanceWeights[g];
   k.radius = static_cast<float>(constants.guidanceRadius);
