@@ -106,20 +106,16 @@ FoldedElementPoints(const FoldRepairConstants & k, const SideView & s, const std
   return flagged;
 }
 
-/** The star term (RepairStar.h) of tetrahedron t around its corner p. */
+/** The star term (RepairStar.h) of tetrahedron t around its corner p. The
+ *  other corners are picked by comparisons rather than gathered into an
+ *  array by a running index, which put the array in local memory. */
 __device__ void
 SideStarTerm(const FoldRepairConstants & k, const SideView & s, std::uint32_t p, std::uint32_t t, StarTerm & term)
 {
-  const double * other[3] = { nullptr, nullptr, nullptr };
-  int            m = 0, slot = 0;
-  for (int j = 0; j < 4; ++j)
-  {
-    const std::uint32_t v = s.tetrahedra[4 * static_cast<std::size_t>(t) + j];
-    if (v == p)
-      slot = j;
-    else if (m < 3)
-      other[m++] = s.Point(v);
-  }
+  const std::uint32_t * v = s.tetrahedra + 4 * static_cast<std::size_t>(t);
+  const int             slot = v[0] == p ? 0 : (v[1] == p ? 1 : (v[2] == p ? 2 : 3));
+  const double * const  other[3] = { s.Point(v[slot == 0 ? 1 : 0]), s.Point(v[slot <= 1 ? 2 : 1]),
+                                     s.Point(v[slot <= 2 ? 3 : 2]) };
   MakeStarTerm(other, slot, k.referenceVolumes[t], k.volumeFraction, term);
 }
 
@@ -201,15 +197,10 @@ DistanceToSurroundingPolyhedron(const FoldRepairConstants & k, const SideView & 
   MeanFaceDistance mean;
   for (std::uint32_t i = k.pointTetrahedronOffsets[p]; i < k.pointTetrahedronOffsets[p + 1]; ++i)
   {
-    const std::uint32_t t = k.pointTetrahedra[i];
-    const double *      f[3];
-    int                 m = 0;
-    for (int j = 0; j < 4; ++j)
-    {
-      const std::uint32_t v = s.tetrahedra[4 * static_cast<std::size_t>(t) + j];
-      if (v != p)
-        f[m++] = s.Point(v);
-    }
+    const std::uint32_t * v = s.tetrahedra + 4 * static_cast<std::size_t>(k.pointTetrahedra[i]);
+    const int             slot = v[0] == p ? 0 : (v[1] == p ? 1 : (v[2] == p ? 2 : 3));
+    const double * const  f[3] = { s.Point(v[slot == 0 ? 1 : 0]), s.Point(v[slot <= 1 ? 2 : 1]),
+                                   s.Point(v[slot <= 2 ? 3 : 2]) };
     mean.AddFace(f, x);
   }
   return mean.Value();
@@ -223,11 +214,20 @@ DistanceToSurroundingPolyhedron(const FoldRepairConstants & k, const SideView & 
  *  of the uncached path. */
 constexpr std::uint32_t MaxStarTetrahedra = 64;
 
+/** A star term padded to 72 bytes in shared memory: the lanes that make a
+ *  star's terms side by side write them 18 words apart, so that at most
+ *  two share a bank (at 64 bytes, 16 did). */
+struct PaddedStarTerm
+{
+  StarTerm term;
+  double   padding;
+};
+
 struct PointStar
 {
   /** A term takes 64 bytes, where the three other corners and the base
    *  volume took 80 and a trial's triple product 23 operations. */
-  StarTerm      terms[MaxStarTetrahedra];
+  PaddedStarTerm terms[MaxStarTetrahedra];
   std::uint32_t count;
   /** Per tetrahedron a term of a sum that the lanes compute side by side
    *  and then add in order (StarViolationOfAll, StarDistance), and whether
@@ -247,7 +247,7 @@ GatherStar(const FoldRepairConstants & k, const SideView & s, std::uint32_t p, u
   const std::uint32_t count = k.pointTetrahedronOffsets[p + 1] - first;
   __syncwarp(); // no lane still reads the previous point's star
   for (std::uint32_t i = lane; i < count; i += 32)
-    SideStarTerm(k, s, p, k.pointTetrahedra[first + i], star.terms[i]);
+    SideStarTerm(k, s, p, k.pointTetrahedra[first + i], star.terms[i].term);
   if (lane == 0)
     star.count = count;
   __syncwarp();
@@ -262,7 +262,7 @@ StarViolation(const PointStar & star, const double * position, double bound, dou
   for (std::uint32_t i = 0; i < star.count; ++i)
   {
     bool f = false;
-    value = Add(value, StarTermViolation(star.terms[i], position, f));
+    value = Add(value, StarTermViolation(star.terms[i].term, position, f));
     folded += f;
     if (value > bound)
       return false;
@@ -281,7 +281,7 @@ StarViolationOfAll(PointStar & star, const double * position, unsigned lane, dou
   for (std::uint32_t i = lane; i < star.count; i += 32)
   {
     bool f = false;
-    star.term[i] = StarTermViolation(star.terms[i], position, f);
+    star.term[i] = StarTermViolation(star.terms[i].term, position, f);
     star.counts[i] = f;
   }
   __syncwarp();
@@ -305,10 +305,10 @@ StarDistance(PointStar & star, const double * x, unsigned lane)
   __syncwarp(); // no lane still reads the terms of the previous sum
   for (std::uint32_t i = lane; i < star.count; i += 32)
   {
-    const double * n = star.terms[i].normal;
+    const double * n = star.terms[i].term.normal;
     const double   area2 = sqrt(Add(Add(Mul(n[0], n[0]), Mul(n[1], n[1])), Mul(n[2], n[2])));
     star.counts[i] = area2 != 0.0;
-    star.term[i] = area2 != 0.0 ? Div(fabs(StarTermVolume(star.terms[i], x)), area2) : 0.0;
+    star.term[i] = area2 != 0.0 ? Div(fabs(StarTermVolume(star.terms[i].term, x)), area2) : 0.0;
   }
   __syncwarp();
   MeanFaceDistance mean;
