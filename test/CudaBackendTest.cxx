@@ -17,6 +17,7 @@
 #include <iostream>
 #include <limits>
 #include <numeric>
+#include <string>
 #include <vector>
 
 using namespace morea;
@@ -454,6 +455,31 @@ TEST(CudaEvaluationBackend, TextureInterpolatesAlongZLikeTheCpuUpToTheEdges)
     }
     std::cout << "slices alternating, target moved " << shift << " mm: largest relative difference " << worst << "\n";
   }
+}
+
+// Slice pairs are 2D layered textures, whose layers a device limits (2048
+// on an H100): a taller image is a clear error for the texture path, which
+// names the way out, and no error for the exact path.
+TEST(CudaEvaluationBackend, TexturePathRefusesImagesTallerThanItsLayers)
+{
+  MOREA_REQUIRE_CUDA_DEVICE();
+  OptimiserTestProblem problem;
+  for (ChannelVolume * image : { &problem.data.fixed, &problem.data.moving })
+  {
+    image->size = { 2, 2, 70000 };
+    image->data.assign(2 * 2 * 2 * 70000, 0.5f);
+  }
+  try
+  {
+    CreateCudaEvaluationBackend(*problem.evaluator, 2, CudaInterpolation::Texture);
+    ADD_FAILURE() << "no error for 70000 slices";
+  }
+  catch (const Error & e)
+  {
+    EXPECT_NE(std::string(e.what()).find("exceeds the texture path's limits"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("--backend cuda"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(CreateCudaEvaluationBackend(*problem.evaluator, 2, CudaInterpolation::Exact)->Name(), "cuda");
 }
 
 // The texture path sizes each part's sampling without waiting for its number

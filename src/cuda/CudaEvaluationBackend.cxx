@@ -687,6 +687,18 @@ private:
       // one filtering pass instead of a 3D texture's two.
       const std::size_t          slice = volume.size[0] * volume.size[1];
       const int                  depth = view.size[2];
+      int                        device = 0, maxLayers = 0, maxWidth = 0, maxHeight = 0;
+      Check(cudaGetDevice(&device), "reading the current device");
+      Check(cudaDeviceGetAttribute(&maxLayers, cudaDevAttrMaxTexture2DLayeredLayers, device),
+            "reading the texture limits");
+      Check(cudaDeviceGetAttribute(&maxWidth, cudaDevAttrMaxTexture2DLayeredWidth, device), "reading the texture limits");
+      Check(cudaDeviceGetAttribute(&maxHeight, cudaDevAttrMaxTexture2DLayeredHeight, device),
+            "reading the texture limits");
+      if (depth + 1 > maxLayers || view.size[0] > maxWidth || view.size[1] > maxHeight)
+        throw Error("CUDA backend: an image of " + std::to_string(view.size[0]) + " x " + std::to_string(view.size[1]) +
+                    " x " + std::to_string(depth) + " voxels exceeds the texture path's limits on this device (" +
+                    std::to_string(maxWidth) + " x " + std::to_string(maxHeight) + " per slice, " +
+                    std::to_string(maxLayers - 1) + " slices); use --backend cuda, or a coarser preprocessing spacing");
       std::vector<std::uint16_t> pairs(2 * slice * (depth + 1));
       for (int l = 0; l <= depth; ++l)
       {
