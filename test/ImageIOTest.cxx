@@ -5,6 +5,8 @@
 #include "itkImageRegionConstIterator.h"
 #include "itkImageRegionIteratorWithIndex.h"
 
+#include "TestScratchDir.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -21,16 +23,10 @@ using namespace itk::morea;
 
 namespace
 {
-/** A fresh, empty scratch folder for the running test. */
 fs::path
 ScratchDir()
 {
-  const auto * info = ::testing::UnitTest::GetInstance()->current_test_info();
-  fs::path     dir = fs::path(MOREA_TEST_OUTPUT_DIR) / "ImageIO" / info->name();
-  std::error_code ec;
-  fs::remove_all(dir, ec);
-  fs::create_directories(dir);
-  return dir;
+  return morea_test::TestScratchDir("ImageIO");
 }
 
 /** File names in `dir` (not recursive), hidden ones included. */

@@ -2,6 +2,8 @@
 #include "itkLandmarkIO.h"
 #include "itkMOREAImageIO.h"
 
+#include "TestScratchDir.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -18,12 +20,7 @@ namespace
 fs::path
 ScratchDir()
 {
-  const auto * info = ::testing::UnitTest::GetInstance()->current_test_info();
-  fs::path     dir = fs::path(MOREA_TEST_OUTPUT_DIR) / "LandmarkIO" / info->name();
-  std::error_code ec;
-  fs::remove_all(dir, ec);
-  fs::create_directories(dir);
-  return dir;
+  return morea_test::TestScratchDir("LandmarkIO");
 }
 
 std::string

@@ -6,6 +6,8 @@
 #include "itkImageRegionConstIterator.h"
 #include "itkImageRegionIteratorWithIndex.h"
 
+#include "TestScratchDir.h"
+
 #include <gtest/gtest.h>
 #include <zlib.h>
 
@@ -27,12 +29,7 @@ namespace
 fs::path
 ScratchDir()
 {
-  const auto *    info = ::testing::UnitTest::GetInstance()->current_test_info();
-  fs::path        dir = fs::path(MOREA_TEST_OUTPUT_DIR) / "ParallelGzip" / info->name();
-  std::error_code ec;
-  fs::remove_all(dir, ec);
-  fs::create_directories(dir);
-  return dir;
+  return morea_test::TestScratchDir("ParallelGzip");
 }
 
 std::vector<unsigned char>

@@ -1,13 +1,15 @@
 // Filtered fetches per second of the texel formats the sampling kernel could
 // use, as a warp's 32 lanes spread over cubes of growing edge: how much a
 // format and the lanes' spread cost on this GPU, apart from the rest of the
-// kernel. Standalone (CUDA runtime only), built where it runs:
-//   nvcc -O3 -arch=sm_90 -o texture-footprints bench/tools/texture-footprints.cu && ./texture-footprints
+// kernel. Needs the CUDA runtime and the project's headers only; built where
+// it runs, from the repository root:
+//   nvcc -O3 -std=c++17 -arch=sm_90 -I include -I src/cuda -o texture-footprints \
+//     bench/tools/texture-footprints.cu && ./texture-footprints
 // Formats: a 3D float texture (the fetch-rate yardstick's), a 3D 16-bit
 // normalised one (the intensity texels), and 2D layers of 16-bit pairs
 // (slices l - 1 and l in one 32-bit texel, trilinear from one bilinear
 // fetch and a lerp along z), and a 3D texture of float2 (two distance maps).
-#include <cuda_runtime.h>
+#include "DeviceMemory.h"
 
 #include <algorithm>
 #include <cstdint>
@@ -17,18 +19,12 @@
 
 namespace
 {
+using morea::cuda::Check;
+using morea::cuda::Texture3D;
+using morea::cuda::TextureLayout;
+
 constexpr int Edge = 256;
 constexpr int Fetches = 64;
-
-void
-Check(cudaError_t e, const char * what)
-{
-  if (e != cudaSuccess)
-  {
-    std::fprintf(stderr, "%s: %s\n", what, cudaGetErrorString(e));
-    std::exit(1);
-  }
-}
 
 __device__ std::uint32_t
 Hash(std::uint32_t x)
@@ -88,31 +84,6 @@ Fetch(cudaTextureObject_t t, float spread, float * out)
   out[thread] = sum;
 }
 
-cudaTextureObject_t
-MakeTexture(cudaChannelFormatDesc format, const void * data, std::size_t texelBytes, int depth, bool layered,
-            bool normalised)
-{
-  cudaArray_t      array = nullptr;
-  const cudaExtent extent = make_cudaExtent(Edge, Edge, depth);
-  Check(cudaMalloc3DArray(&array, &format, extent, layered ? cudaArrayLayered : 0), "array");
-  cudaMemcpy3DParms copy{};
-  copy.srcPtr = make_cudaPitchedPtr(const_cast<void *>(data), Edge * texelBytes, Edge, Edge);
-  copy.dstArray = array;
-  copy.extent = extent;
-  copy.kind = cudaMemcpyHostToDevice;
-  Check(cudaMemcpy3D(&copy), "copy");
-  cudaResourceDesc resource{};
-  resource.resType = cudaResourceTypeArray;
-  resource.res.array.array = array;
-  cudaTextureDesc d{};
-  d.addressMode[0] = d.addressMode[1] = d.addressMode[2] = cudaAddressModeClamp;
-  d.filterMode = cudaFilterModeLinear;
-  d.readMode = normalised ? cudaReadModeNormalizedFloat : cudaReadModeElementType;
-  cudaTextureObject_t t = 0;
-  Check(cudaCreateTextureObject(&t, &resource, &d, nullptr), "texture");
-  return t;
-}
-
 template <int F>
 double
 Rate(cudaTextureObject_t t, float spread, float * out, int threads)
@@ -159,22 +130,22 @@ main()
       pairs[2 * (l * slice + v)] = u[std::max(l - 1, 0) * slice + v];
       pairs[2 * (l * slice + v) + 1] = u[std::min(l, Edge - 1) * slice + v];
     }
-  const cudaTextureObject_t tf = MakeTexture(cudaCreateChannelDesc<float>(), f.data(), 4, Edge, false, false);
-  const cudaTextureObject_t tu =
-    MakeTexture(cudaCreateChannelDesc<unsigned short>(), u.data(), 2, Edge, false, true);
-  const cudaTextureObject_t tp =
-    MakeTexture(cudaCreateChannelDesc<ushort2>(), pairs.data(), 4, Edge + 1, true, true);
-  const cudaTextureObject_t t2 = MakeTexture(cudaCreateChannelDesc<float2>(), f2.data(), 8, Edge, false, false);
+  const int       volume[3] = { Edge, Edge, Edge }, layers[3] = { Edge, Edge, Edge + 1 };
+  const Texture3D tf(f.data(), 4, cudaCreateChannelDesc<float>(), volume);
+  const Texture3D tu(u.data(), 2, cudaCreateChannelDesc<unsigned short>(), volume);
+  const Texture3D tp(pairs.data(), 4, cudaCreateChannelDesc<ushort2>(), layers, TextureLayout::Layers);
+  const Texture3D t2(f2.data(), 8, cudaCreateChannelDesc<float2>(), volume);
   const int                 threads = 132 * 2048 * 4;
-  float *                   out = nullptr;
-  Check(cudaMalloc(&out, threads * sizeof(float)), "out");
+  morea::cuda::DeviceArray<float> buffer(threads);
+  float *                         out = buffer.Data();
   cudaDeviceProp p{};
   cudaGetDeviceProperties(&p, 0);
   std::printf("%s; filtered fetches per second (1e9) by the edge of the cube a warp's lanes spread over\n", p.name);
   std::printf("%8s %12s %12s %12s %12s\n", "edge", "float 3D", "ushort 3D", "pair layers", "float2 3D");
   for (float spread : { 0.0f, 1.0f, 2.0f, 3.0f, 4.0f, 6.0f, 8.0f, 12.0f, 16.0f, 32.0f })
-    std::printf("%8.0f %12.1f %12.1f %12.1f %12.1f\n", spread, 1e-9 * Rate<Float3D>(tf, spread, out, threads),
-                1e-9 * Rate<Ushort3D>(tu, spread, out, threads), 1e-9 * Rate<PairLayers>(tp, spread, out, threads),
-                1e-9 * Rate<Float2x3D>(t2, spread, out, threads));
+    std::printf("%8.0f %12.1f %12.1f %12.1f %12.1f\n", spread, 1e-9 * Rate<Float3D>(tf.Get(), spread, out, threads),
+                1e-9 * Rate<Ushort3D>(tu.Get(), spread, out, threads),
+                1e-9 * Rate<PairLayers>(tp.Get(), spread, out, threads),
+                1e-9 * Rate<Float2x3D>(t2.Get(), spread, out, threads));
   return 0;
 }

@@ -719,9 +719,8 @@ private:
       const std::size_t structures = volume.channels - 1;
       if (structures > 0)
       {
-        if (structures > static_cast<std::size_t>(cuda::MaxTextureStructures))
-          throw Error("CUDA backend: the texture path reads at most 3 guidance structures");
-        // One float map per structure. (16-bit normalised distance texels
+        // One float map per structure (the packed path holds at most
+        // MaxTextureStructures). (16-bit normalised distance texels
         // measured 11 % slower on an H100.)
         std::vector<float> distance(voxels);
         for (std::size_t g = 0; g < structures; ++g)
