@@ -244,6 +244,52 @@ TEST(CudaEvaluationBackend, PartialCandidatesAgreeWithTheCpu)
       ASSERT_EQ(l[j][t].samples, expected.samples);
       ASSERT_EQ(l[j][t].magnitude, expected.magnitude);
     }
+
+  // The lean call the optimiser makes: every candidate's sum comes with its
+  // part, bit for bit the sum of its values added in order; its values only
+  // where FetchValues asks (here every third candidate's), the others'
+  // untouched.
+  const TetrahedronValues       untouched{ -1.0, -2.0, -3.0, -4.0, -5.0, -6.0 };
+  std::vector<TetrahedronValues> sums(large.size(), untouched);
+  for (std::size_t j = 0; j < large.size(); ++j)
+  {
+    std::fill(l[j].begin(), l[j].end(), untouched);
+    large[j].sum = &sums[j];
+  }
+  auto        lean = CreateCudaEvaluationBackend(*problem.evaluator, 2, CudaInterpolation::Texture);
+  std::size_t fetched = 0;
+  lean->EvaluatePartials(
+    large,
+    [&](std::size_t begin, std::size_t end) {
+      std::vector<std::size_t> which;
+      for (std::size_t j = begin; j < end; ++j)
+        if (j % 3 == 0)
+          which.push_back(j);
+      lean->FetchValues(large, which);
+      fetched += which.size();
+    },
+    EvaluationBackend::Meanwhile{});
+  ASSERT_GT(fetched, 0u);
+  for (std::size_t j = 0; j < large.size(); ++j)
+  {
+    const std::vector<TetrahedronValues> & expected = c[j % candidates.size()];
+    ObjectiveTotals                        total;
+    for (const TetrahedronValues & v : expected)
+      total.Add(v);
+    const std::string what = "candidate " + std::to_string(j);
+    ASSERT_EQ(sums[j].intensity, total.sum.intensity) << what;
+    ASSERT_EQ(sums[j].guidance, total.sum.guidance) << what;
+    ASSERT_EQ(sums[j].samples, total.sum.samples) << what;
+    ASSERT_EQ(sums[j].magnitude, total.sum.magnitude) << what;
+    ASSERT_EQ(sums[j].foldValue, total.sum.foldValue) << what;
+    ASSERT_EQ(sums[j].folded, total.sum.folded) << what;
+    for (std::size_t t = 0; t < l[j].size(); ++t)
+    {
+      const TetrahedronValues & want = j % 3 == 0 ? expected[t] : untouched;
+      ASSERT_EQ(l[j][t].intensity, want.intensity) << what << ", tetrahedron " << t;
+      ASSERT_EQ(l[j][t].samples, want.samples) << what << ", tetrahedron " << t;
+    }
+  }
 }
 
 TEST(CudaEvaluationBackend, VolumeBoundFoldsAgreeWithTheCpu)

@@ -41,8 +41,16 @@ struct PartialCandidate
   /** New positions, one per element point; a fold repair rewrites them. */
   Vec3 * source{ nullptr };
   Vec3 * target{ nullptr };
-  /** Output: one entry per element->dependentTetrahedra, in that order. */
+  /** Output: one entry per element->dependentTetrahedra, in that order.
+   *  From the three-argument EvaluatePartials a backend may write them only
+   *  once FetchValues asks (the CUDA backend reads every tetrahedron's
+   *  values of a batch back, but unpacks them only for the candidates
+   *  acceptance keeps: about 2 % late in a run). */
   TetrahedronValues * values{ nullptr };
+  /** Output with `values`: their sum, added in that order from 0
+   *  (ObjectiveTotals::Add), which is all that acceptance needs; null: not
+   *  wanted. */
+  TetrahedronValues * sum{ nullptr };
   /** Output of the fold check (see FoldHandling); null: no check. */
   CandidateFolds * folds{ nullptr };
   /** Seeds the repair's moves (RepairSeed gives each side's). */
@@ -60,6 +68,26 @@ struct PartialCandidate
    *  null: always sampled. */
   RefusalBound * bound{ nullptr };
 };
+
+/** Whether EvaluatePartials gives candidate `c` values: not when it is left
+ *  folded and needs none (`evaluateFolded` off). */
+inline bool
+HasValues(const PartialCandidate & c)
+{
+  return !(c.folds && c.folds->Folded() && !c.evaluateFolded);
+}
+
+/** Writes c.sum (where wanted) from c.values as PartialCandidate::sum says. */
+inline void
+SumCandidateValues(const PartialCandidate & c)
+{
+  if (c.sum == nullptr)
+    return;
+  ObjectiveTotals sum;
+  for (std::size_t k = 0; k < c.element->dependentTetrahedra.size(); ++k)
+    sum.Add(c.values[k]);
+  *c.sum = sum.sum;
+}
 
 /** How EvaluatePartials treats folds (SPEC 5). Each side of a candidate with
  *  `folds` set is checked over the element's dependent tetrahedra before it is
@@ -160,11 +188,12 @@ public:
   using Meanwhile = std::function<void()>;
 
   /** The dependent tetrahedra of every candidate, each with its moved points;
-   *  fold checks first where asked for (SetFoldHandling). */
+   *  fold checks first where asked for (SetFoldHandling). Every candidate
+   *  that gets values (HasValues) gets its `values` and `sum`. */
   void
   EvaluatePartials(const std::vector<PartialCandidate> & candidates)
   {
-    EvaluatePartials(candidates, ReadyCandidates{}, Meanwhile{});
+    EvaluatePartials(candidates, ReadyCandidates{});
   }
 
   /** As above, calling `ready` (if set) for consecutive ranges that cover all
@@ -174,14 +203,26 @@ public:
   void
   EvaluatePartials(const std::vector<PartialCandidate> & candidates, const ReadyCandidates & ready)
   {
-    EvaluatePartials(candidates, ready, Meanwhile{});
+    EvaluatePartials(
+      candidates,
+      [this, &candidates, &ready](std::size_t begin, std::size_t end) {
+        std::vector<std::size_t> which;
+        for (std::size_t i = begin; i < end; ++i)
+          if (HasValues(candidates[i]))
+            which.push_back(i);
+        FetchValues(candidates, which);
+        if (ready)
+          ready(begin, end);
+      },
+      Meanwhile{});
   }
 
-  /** As above, calling `meanwhile` (if set) once, on the calling thread,
-   *  before the first `ready`: the CUDA backend calls it once the device
-   *  has work queued, so the caller prepares its next batch while the device
-   *  computes this one. It must not touch the candidates, their points or
-   *  their parents. */
+  /** As above, but a candidate's `values` may wait for FetchValues (its
+   *  `sum` does not), and `meanwhile` (if set) is called once, on the
+   *  calling thread, before the first `ready`: the CUDA backend calls it
+   *  once the device has work queued, so the caller prepares its next batch
+   *  while the device computes this one. It must not touch the candidates,
+   *  their points or their parents. */
   virtual void
   EvaluatePartials(const std::vector<PartialCandidate> & candidates, const ReadyCandidates & ready,
                    const Meanwhile & meanwhile) = 0;
@@ -218,6 +259,17 @@ public:
     static_cast<void>(screen);
   }
 
+  /** Writes `values` of candidates `which` of the current EvaluatePartials
+   *  call, from `ready` for a part holding them; those written already
+   *  (SampleSkipped) stay as they are. Does nothing by default (values
+   *  written with the sums). */
+  virtual void
+  FetchValues(const std::vector<PartialCandidate> & candidates, const std::vector<std::size_t> & which)
+  {
+    static_cast<void>(candidates);
+    static_cast<void>(which);
+  }
+
   /** Whether StartNextPartials would start a head now (from `ready`): the
    *  caller works out the head only then. False by default. */
   virtual bool
@@ -228,7 +280,7 @@ public:
 
   /** Samples candidates `which` of the current EvaluatePartials call that
    *  their bound skipped (RefusalBound::skipped), completing their values
-   *  and clearing the flag; for the optimiser's exact check, when a bound
+   *  and sums and clearing the flag; for the optimiser's exact check, when a bound
    *  computed before the call no longer refuses one. Only from `ready`,
    *  for candidates already handed over; synchronous. */
   virtual void

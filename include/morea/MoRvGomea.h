@@ -254,9 +254,10 @@ private:
   /** Candidate i's refusal bound from its parent's state (RefusalScreen::fill). */
   void
   FillBound(CandidateBatch & candidateBatch, std::size_t i) const;
-  /** How candidate `c` of solution `s` changes its totals, given its values. */
+  /** How candidate `c` of solution `s` changes its totals, given the sum of
+   *  its values (PartialCandidate::sum). */
   TetrahedronValues
-  CandidateChange(std::size_t s, const Candidate & c, const TetrahedronValues * values) const;
+  CandidateChange(std::size_t s, const Candidate & c, const TetrahedronValues & sum) const;
   /** Solution s's values summed over element e's dependent tetrahedra, kept
    *  per solution and element: a batch's bounds and changes read each once
    *  (rather than the tetrahedra's values twice). Brought up to date, where

@@ -178,10 +178,12 @@ public:
       {
         c.bound->skipped = true;
         c.bound->witness = entry < screen->witnesses.size() ? screen->witnesses[entry] : 0;
+        SumCandidateValues(c);
         return;
       }
       for (std::size_t k = 0; k < dependent.size(); ++k)
         m_Evaluator.AddSampleSums(corners[k][0], corners[k][1], c.values[k]);
+      SumCandidateValues(c);
     });
     ++m_Statistics.batches;
     for (std::size_t i = 0; i < candidates.size(); ++i)
@@ -213,7 +215,10 @@ public:
     for (std::size_t i : which)
       if (i >= candidates.size() || !candidates[i].bound || !candidates[i].bound->skipped)
         throw Error("evaluation backend: only candidates the bound skipped can be sampled later");
-    m_Pool->ParallelFor(which.size(), [&](std::size_t w) { AddSampleSums(candidates[which[w]]); });
+    m_Pool->ParallelFor(which.size(), [&](std::size_t w) {
+      AddSampleSums(candidates[which[w]]);
+      SumCandidateValues(candidates[which[w]]);
+    });
     for (std::size_t i : which)
     {
       const PartialCandidate & c = candidates[i];

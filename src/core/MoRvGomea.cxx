@@ -179,6 +179,8 @@ struct MoRvGomea::CandidateBatch
   std::vector<Vec3>              source, target;
   std::vector<double>            samples; ///< drawn variables (before projection), for the ratio test
   std::vector<TetrahedronValues> values;
+  /** Per candidate, the sum of its values (PartialCandidate::sum). */
+  std::vector<TetrahedronValues> sums;
   /** The backend's view of the candidates and their fold outcomes
    *  (BuildPartials); `partialsBuilt` until ProcessCandidates uses them. */
   std::vector<PartialCandidate> partials;
@@ -781,6 +783,7 @@ MoRvGomea::BuildPartials(CandidateBatch & candidateBatch) const
   // Sized here, reset on the pool: a serial fill of a paper-scale
   // generation's bounds took about 3 ms of it.
   candidateBatch.folds.resize(candidates.size());
+  candidateBatch.sums.resize(candidates.size());
   candidateBatch.bounds.resize(m_Options.boundRefusals ? candidates.size() : 0);
   m_Pool->ParallelFor(candidates.size(), [&](std::size_t i) {
     const Candidate &  c = candidates[i];
@@ -794,6 +797,7 @@ MoRvGomea::BuildPartials(CandidateBatch & candidateBatch) const
     p.source = candidateBatch.Source(c);
     p.target = candidateBatch.Target(c);
     p.values = candidateBatch.Values(c);
+    p.sum = &candidateBatch.sums[i];
     p.folds = &candidateBatch.folds[i];
     p.seed = c.seed;
     p.evaluateFolded = true;
@@ -996,7 +1000,7 @@ MoRvGomea::AcceptCandidates(CandidateBatch & candidateBatch, const std::vector<P
     {
       const std::size_t  b = j.order[chain.at];
       const Candidate &  c = candidates[batchIndex[b]];
-      j.changes[b] = CandidateChange(s, c, candidateBatch.Values(c));
+      j.changes[b] = CandidateChange(s, c, candidateBatch.sums[batchIndex[b]]);
       ObjectiveTotals totals = chain.held;
       totals.Add(j.changes[b]);
       const Fitness next = Steered(totals.ToFitness(m_Topology.NumberOfTetrahedra()));
@@ -1055,6 +1059,7 @@ MoRvGomea::AcceptCandidates(CandidateBatch & candidateBatch, const std::vector<P
   std::vector<bool>         overturned(m_Population.size(), false);
   std::vector<std::uint8_t> acceptedOf(m_Population.size(), 0);
   std::vector<std::uint32_t> changed; // the solutions with an accepted candidate
+  std::vector<std::size_t>   acceptedCandidates;
   const std::uint64_t revision = m_Archive->ThinningRevision();
   std::size_t         accepted = 0;
   for (std::size_t b = 0; b < count; ++b)
@@ -1078,7 +1083,7 @@ MoRvGomea::AcceptCandidates(CandidateBatch & candidateBatch, const std::vector<P
           m_Archive->Judge(low, j.verdicts[b].witness).kind == ArchiveVerdict::Kind::Rejected)
         continue;
       m_Backend.SampleSkipped(batch, { batchIndex[b] });
-      j.changes[b] = CandidateChange(s, c, candidateBatch.Values(c));
+      j.changes[b] = CandidateChange(s, c, candidateBatch.sums[batchIndex[b]]);
       totals = m_Totals[s];
       totals.Add(j.changes[b]);
       sampledNow = true;
@@ -1113,6 +1118,7 @@ MoRvGomea::AcceptCandidates(CandidateBatch & candidateBatch, const std::vector<P
     m_Archive->Insert(*next, solution, m_Ids[s], verdict);
     c.accepted = true;
     ++accepted;
+    acceptedCandidates.push_back(batchIndex[b]);
     if (!acceptedOf[s])
       changed.push_back(static_cast<std::uint32_t>(s));
     acceptedOf[s] = 1;
@@ -1124,6 +1130,7 @@ MoRvGomea::AcceptCandidates(CandidateBatch & candidateBatch, const std::vector<P
   // (and so disjoint elements' sums). One solution per task, so no two
   // tasks mark one flag.
   const std::size_t elements = m_Parallel.elements.size();
+  m_Backend.FetchValues(batch, acceptedCandidates);
   m_Pool->ParallelFor(changed.size(), [&](std::size_t k) {
     const std::size_t s = changed[k];
     for (std::size_t at = j.chainStart[s]; at < j.chainStart[s + 1]; ++at)
@@ -1146,12 +1153,11 @@ MoRvGomea::AcceptCandidates(CandidateBatch & candidateBatch, const std::vector<P
 }
 
 TetrahedronValues
-MoRvGomea::CandidateChange(std::size_t s, const Candidate & c, const TetrahedronValues * values) const
+MoRvGomea::CandidateChange(std::size_t s, const Candidate & c, const TetrahedronValues & sum) const
 {
-  const std::size_t count = m_Parallel.elements[c.element].dependentTetrahedra.size();
-  ObjectiveTotals   change;
-  for (std::size_t k = 0; k < count; ++k)
-    change.Add(values[k]);
+  // The sum of the candidate's values, added in order from 0: the bits a
+  // sum over its values here would give.
+  ObjectiveTotals change{ sum };
   change.Add(ElementSum(s, c.element), -1.0);
   return change.sum;
 }

@@ -25,7 +25,9 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <functional>
+#include <type_traits>
 #include <unordered_map>
 #include <vector>
 
@@ -58,6 +60,9 @@ struct VolumeTextures
 };
 
 static_assert(NearContourBlocks::BlockSize == cuda::NearBlockSize, "the sampling kernel's blocks are the core's");
+static_assert(sizeof(TetrahedronValues) == cuda::CandidateSumValues * sizeof(double) &&
+                std::is_trivially_copyable_v<TetrahedronValues>,
+              "a candidate's sum is copied as the device lays it out");
 
 /** A batch of partial candidates packed on the host for the device, but for
  *  what depends on the parents' points and keys. Packed by
@@ -128,6 +133,11 @@ struct BatchFlight
   cuda::DeviceArray<std::uint32_t> tetrahedra;
   cuda::DeviceArray<std::uint8_t>  itemSkip; ///< per item: ItemSkip
   cuda::PinnedArray<double>        hostItemValues, hostDirectionValues;
+  /** Per candidate: its items' values summed (LaunchSumCandidateValues),
+   *  all the host unpacks of most candidates (see FetchValues). */
+  cuda::DeviceArray<double>        candidateSums;
+  cuda::PinnedArray<double>        hostCandidateSums;
+  std::vector<std::uint8_t>        valuesWritten; ///< per candidate: its values are on the host (SampleSkipped)
   cuda::DeviceArray<std::uint8_t>  outcome; ///< per candidate side: the fold checks' outcome
   cuda::PinnedArray<std::uint8_t>  hostOutcome;
   cuda::PinnedArray<std::uint32_t> hostChunks; ///< per part: the texture set-up's number of chunks
@@ -440,6 +450,25 @@ public:
     return true;
   }
 
+  /** The batch's values were read back with its sums; here they are
+   *  unpacked for the few candidates the caller keeps. */
+  void
+  FetchValues(const std::vector<PartialCandidate> & candidates, const std::vector<std::size_t> & which) override
+  {
+    const auto             start = std::chrono::steady_clock::now();
+    const HostCandidates & h = m_HostCandidates[m_CurrentHost];
+    const BatchFlight &    f = *m_Flights[m_CurrentHost];
+    for (std::size_t i : which)
+      if (i >= candidates.size() || i >= f.valuesWritten.size() || Skipped(candidates[i]))
+        throw Error("evaluation backend: values asked for a candidate without them");
+    m_Pool->ParallelFor(which.size(), [&](std::size_t w) {
+      const std::size_t i = which[w];
+      if (!f.valuesWritten[i])
+        UnpackValues(f, h.firstItem.Data(), i, candidates[i]);
+    });
+    m_Statistics.unpackSeconds += SecondsSince(start);
+  }
+
   void
   SampleSkipped(const std::vector<PartialCandidate> & candidates, const std::vector<std::size_t> & which) override
   {
@@ -532,11 +561,14 @@ public:
             "copying values from the device");
       Check(cudaStreamSynchronize(stream), "sampling skipped candidates");
     }
-    // Intensity and guidance as Unpack() adds them; the rest is the bound's.
+    // Intensity and guidance as Unpack() adds them; the rest is the bound's
+    // (the batch's values of the candidate); then the sum of them all.
     std::size_t at = 0;
     for (std::size_t i : which)
     {
       const PartialCandidate & c = candidates[i];
+      UnpackValues(f, h.firstItem.Data(), i, c);
+      m_Flights[m_CurrentHost]->valuesWritten[i] = 1;
       double                   samples = 0.0;
       for (std::size_t k = 0; k < c.element->dependentTetrahedra.size(); ++k, ++at)
       {
@@ -545,6 +577,7 @@ public:
         c.values[k].guidance = d[1] + d[4];
         samples += c.values[k].samples;
       }
+      SumCandidateValues(c);
       c.bound->skipped = false;
       ++m_Statistics.boundSampledLater;
       m_Statistics.samples += samples;
@@ -627,7 +660,7 @@ private:
   static bool
   Skipped(const PartialCandidate & c)
   {
-    return c.folds && c.folds->Folded() && !c.evaluateFolded;
+    return !HasValues(c);
   }
 
   template <typename T>
@@ -1188,6 +1221,30 @@ private:
     return out;
   }
 
+  /** Candidate c's sum of flight `f` (LaunchSumCandidateValues' layout). */
+  static TetrahedronValues
+  SumOf(const BatchFlight & f, std::size_t c)
+  {
+    TetrahedronValues sum;
+    std::memcpy(&sum, f.hostCandidateSums.Data() + c * cuda::CandidateSumValues, sizeof sum);
+    return sum;
+  }
+
+  static void
+  WriteSum(BatchFlight & f, std::size_t c, const TetrahedronValues & sum)
+  {
+    std::memcpy(f.hostCandidateSums.Data() + c * cuda::CandidateSumValues, &sum, sizeof sum);
+  }
+
+  /** Candidate i's values from flight `f`'s items (first[i] ...). */
+  static void
+  UnpackValues(const BatchFlight & f, const std::uint64_t * first, std::size_t i, const PartialCandidate & c)
+  {
+    TetrahedronValues * o = c.values;
+    for (std::uint64_t item = first[i]; item < first[i + 1]; ++item)
+      *o++ = Unpack(f, item);
+  }
+
   static double
   ElapsedSeconds(const cuda::Event & from, const cuda::Event & to)
   {
@@ -1266,6 +1323,9 @@ private:
       Check(cudaEventRecord(f.staged.Get(), m_Stream->Get()), "recording an event");
     f.skipItems = true;
     ReserveItems(f, f.items);
+    f.candidateSums.Reserve(std::max<std::size_t>(1, n) * cuda::CandidateSumValues);
+    f.hostCandidateSums.Reserve(std::max<std::size_t>(1, n) * cuda::CandidateSumValues);
+    f.valuesWritten.assign(n, 0);
     if (f.checks)
     {
       f.outcome.Reserve(2 * n);
@@ -1422,6 +1482,16 @@ private:
                                      f.tetrahedra.Data() + begin, f.skipItems ? f.itemSkip.Data() + begin : nullptr,
                                      count, itemValues, directionValues, stream);
     }
+    // A batch of candidates (not whole solutions): each one's sum.
+    const std::size_t firstCandidate = f.candidateBounds[p], endCandidate = f.candidateBounds[p + 1];
+    if (f.skipItems && endCandidate > firstCandidate)
+    {
+      cuda::CandidateBatch part = m_Batch; // this flight's tables: queued right after their upload
+      part.firstCandidate = firstCandidate;
+      part.candidates = endCandidate;
+      cuda::LaunchSumCandidateValues(part, f.itemValues.Data(), f.directionValues.Data(), f.candidateSums.Data(),
+                                     stream);
+    }
     Check(cudaEventRecord(f.PartEvent(p, BatchFlight::SamplingEnd), stream), "recording an event");
     // The values go back on the copy stream, so that the next part's
     // kernels do not wait for the transfer (about 70 bytes per tetrahedron).
@@ -1432,6 +1502,12 @@ private:
     Check(cudaMemcpyAsync(f.hostDirectionValues.Data() + begin * 2 * cuda::DirectionValues, directionValues,
                           count * 2 * cuda::DirectionValues * sizeof(double), cudaMemcpyDeviceToHost, copies),
           "copying values from the device");
+    if (f.skipItems && endCandidate > firstCandidate)
+      Check(cudaMemcpyAsync(f.hostCandidateSums.Data() + firstCandidate * cuda::CandidateSumValues,
+                            f.candidateSums.Data() + firstCandidate * cuda::CandidateSumValues,
+                            (endCandidate - firstCandidate) * cuda::CandidateSumValues * sizeof(double),
+                            cudaMemcpyDeviceToHost, copies),
+            "copying candidate sums from the device");
     Check(cudaEventRecord(f.copiedEvents[p]->Get(), copies), "recording an event");
   }
 
@@ -1448,9 +1524,10 @@ private:
 
   /** Part `p` of flight `f`, whose values are on the host, sampled again
    *  where it had more chunks than room for them; and the room of later
-   *  parts made enough for it. */
+   *  parts made enough for it. `first`: the candidates' first items (null
+   *  for whole solutions), whose sums are then made again. */
   void
-  CompleteOverflowingPart(BatchFlight & f, std::size_t p)
+  CompleteOverflowingPart(BatchFlight & f, std::size_t p, const std::uint64_t * first)
   {
     if (!UsesTexturePath())
       return;
@@ -1472,6 +1549,15 @@ private:
           "copying values from the device");
     Check(cudaStreamSynchronize(stream), "sampling a part again");
     ++m_Statistics.partsSampledAgain;
+    // The device summed the values that overflowed: the same sums afresh.
+    if (first != nullptr)
+      for (std::size_t c = f.candidateBounds[p]; c < f.candidateBounds[p + 1]; ++c)
+      {
+        ObjectiveTotals sum;
+        for (std::uint64_t item = first[c]; item < first[c + 1]; ++item)
+          sum.Add(Unpack(f, item));
+        WriteSum(f, c, sum.sum);
+      }
   }
 
   /** Hands the parts of flight `f` over in order as their values arrive:
@@ -1488,25 +1574,14 @@ private:
     for (std::size_t p = 0; p < parts; ++p)
     {
       WaitFor(f.copiedEvents[p]->Get(), "copying values from the device");
-      CompleteOverflowingPart(f, p);
+      CompleteOverflowingPart(f, p, first);
       // Read before ready() may start the next batch on the previous flight.
       if (p == 0 && f.items > 0 && m_PreviousFlight)
         m_Statistics.devicePhases.betweenBatches += ElapsedSeconds(m_PreviousFlight->end, f.start);
       const auto unpack = std::chrono::steady_clock::now();
       ReadFoldChecks(candidates, h, f, p);
       const std::size_t begin = f.candidateBounds[p], end = f.candidateBounds[p + 1];
-      skippedItems += UnpackRange(
-        f, first, begin, end,
-        [&](std::size_t i) -> TetrahedronValues * {
-          if (RefusalBound * bound = candidates[i].bound)
-          {
-            const std::uint32_t by = spared ? spared[i] : 0;
-            bound->skipped = by != 0;
-            bound->witness = by != 0 && by - 1 < witnesses.size() ? witnesses[by - 1] : 0;
-          }
-          return Skipped(candidates[i]) ? nullptr : candidates[i].values; // left alone, as on the CPU
-        },
-        spared);
+      skippedItems += UnpackSums(candidates, f, first, begin, end, spared, witnesses);
       m_Statistics.unpackSeconds += SecondsSince(unpack);
       // The caller may start the next batch's head while handing over the
       // next-to-last part: it runs behind the last one.
@@ -1554,12 +1629,50 @@ private:
     PreparePart(f, 0);
     QueueSampling(f);
     WaitFor(f.copiedEvents[0]->Get(), "evaluating tetrahedra");
-    CompleteOverflowingPart(f, 0);
+    CompleteOverflowingPart(f, 0, nullptr);
     WaitFor(f.end.Get(), "evaluating tetrahedra");
     AddKernelSeconds(f);
     ++m_Statistics.batches;
     m_Statistics.tetrahedra += items;
     m_PreviousFlight = nullptr; // its end is not a batch's
+  }
+
+  /** Hands candidates [begin, end) of flight `f` their sums (their values
+   *  wait for FetchValues) and bounds' outcome, counting their samples;
+   *  those left folded without values are left alone, as on the CPU.
+   *  `spared` (null: none): per candidate, the refusal screen's verdict.
+   *  Returns the number of items left alone. */
+  std::uint64_t
+  UnpackSums(const std::vector<PartialCandidate> & candidates, const BatchFlight & f, const std::uint64_t * first,
+             std::size_t begin, std::size_t end, const std::uint32_t * spared, const std::vector<std::uint64_t> & witnesses)
+  {
+    std::uint64_t itemsLeftAlone = 0;
+    for (std::size_t i = begin; i < end; ++i)
+    {
+      const PartialCandidate & c = candidates[i];
+      const std::uint32_t      by = spared ? spared[i] : 0;
+      if (c.bound)
+      {
+        c.bound->skipped = by != 0;
+        c.bound->witness = by != 0 && by - 1 < witnesses.size() ? witnesses[by - 1] : 0;
+      }
+      if (Skipped(c))
+      {
+        itemsLeftAlone += first[i + 1] - first[i];
+        continue;
+      }
+      const TetrahedronValues sum = SumOf(f, i);
+      if (c.sum)
+        *c.sum = sum;
+      if (by != 0)
+      {
+        ++m_Statistics.boundSkipped;
+        m_Statistics.boundSkippedSamples += sum.samples;
+      }
+      else
+        m_Statistics.samples += sum.samples;
+    }
+    return itemsLeftAlone;
   }
 
   /** Unpacks items [first[i], first[i + 1]) of flight `f` into out(i) for

@@ -124,6 +124,8 @@ constexpr int ItemValues = 3;
 constexpr int DirectionValues = 3;
 /** Corners of one work item: source 4 x 3 then target 4 x 3 doubles. */
 constexpr int ItemCorners = 24;
+/** Per candidate: its items' values summed, in TetrahedronValues' order. */
+constexpr int CandidateSumValues = 6;
 
 /** Per item of a batch (`itemSkip` bytes): sampled, or not sampled since its
  *  values go unused (a candidate left folded: no sample counts either), or
@@ -159,6 +161,15 @@ struct FoldedCandidateSkip
 void
 LaunchGatherCandidateCorners(const CandidateBatch & batch, std::size_t items, const FoldedCandidateSkip & skip,
                              double * corners, std::uint32_t * tetrahedra, std::uint8_t * itemSkip, void * stream);
+
+/** Per candidate of [batch.firstCandidate, batch.candidates): the sum over
+ *  its items (in order, from 0, as the host adds them) of their values as
+ *  the host unpacks them from `itemValues` and `directionValues`, to
+ *  sums[c * CandidateSumValues ...] (magnitude, intensity, guidance,
+ *  samples, fold value, folded). Asynchronous on `stream`. */
+void
+LaunchSumCandidateValues(const CandidateBatch & batch, const double * itemValues, const double * directionValues,
+                         double * sums, void * stream);
 
 /** Copies parent i of `staged` (count x perParent doubles) to slot
  *  slots[i] of `store` (perParent doubles per slot). Asynchronous on
