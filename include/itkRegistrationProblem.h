@@ -10,6 +10,7 @@
 
 #include "itkMOREATypes.h"
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -38,7 +39,7 @@ public:
   LandmarkListType       fixedLandmarks;
   LandmarkListType       movingLandmarks;
 
-  /** Loads the images (file or DICOM folder). */
+  /** Loads the images (file or DICOM folder), both at once. */
   void
   LoadImages(const std::string & fixedPath, const std::string & movingPath);
 
@@ -53,6 +54,20 @@ public:
    *  resampled onto the image grid. Throws with the source in the message. */
   void
   LoadStructure(const std::string & name, bool fixedSide, const std::string & source);
+
+  /** One side of a structure to load (LoadStructure's arguments). */
+  struct StructureSource
+  {
+    std::string name;
+    bool        fixedSide{ true };
+    std::string source;
+  };
+
+  /** LoadStructure for each source, read side by side: a label map named by
+   *  several sources is read once. Structures are added in the order of
+   *  `sources`; the first failure in that order is the one thrown. */
+  void
+  LoadStructures(const std::vector<StructureSource> & sources);
 
   /** Loads a body mask (any mask source form above) for one side. */
   void
@@ -76,8 +91,20 @@ public:
   Validate() const;
 
 private:
+  /** Reads a label map by path (LoadStructures shares one read per path). */
+  using LabelMapReader = std::function<LabelMapType::Pointer(const std::string & path)>;
+
   MaskType::Pointer
-  LoadMask(const std::string & source, const ImageType * grid, PointListType * contourPoints) const;
+  LoadMask(const std::string & source, const ImageType * grid, PointListType * contourPoints,
+           const LabelMapReader & readLabels = {}) const;
+  /** The structure called `name`, added (empty) when there is none. */
+  Structure &
+  StructureNamed(const std::string & name);
+  /** The mask and/or points of `source` for a side whose image is `grid`;
+   *  true when it gives the side's points (a point file, an RTSTRUCT). */
+  bool
+  LoadSide(const std::string & source, const ImageType * grid, MaskType::Pointer & mask, PointListType & points,
+           const LabelMapReader & readLabels) const;
 };
 
 } // namespace morea

@@ -1,5 +1,6 @@
 // Tests of the module's image reading, validation and (atomic) writing.
 #include "itkMOREAImageIO.h"
+#include "itkRegistrationProblem.h"
 
 #include "itkImageFileWriter.h"
 #include "itkImageRegionConstIterator.h"
@@ -715,4 +716,125 @@ TEST(ImageIO, ReadsTheRealLungCT)
     const auto mask = ReadMask(maskPath);
     EXPECT_TRUE(SameGrid(image, mask));
   }
+}
+
+// ---------------------------------------------------------------------------
+// Loading a problem's structures side by side
+// ---------------------------------------------------------------------------
+
+namespace
+{
+/** A problem folder: two images, a label map with names, a mask, a point file. */
+struct StructureFiles
+{
+  fs::path dir;
+  std::vector<RegistrationProblem::StructureSource> sources;
+
+  StructureFiles()
+    : dir(ScratchDir())
+  {
+    const auto image = MakeImage(false);
+    WriteWithItk<ImageType>(image, (dir / "fixed.mha").string());
+    WriteWithItk<ImageType>(MakeImage(false, 5.0f), (dir / "moving.mha").string());
+    auto labels = LabelMapType::New();
+    SetGeometry(labels.GetPointer(), LabelMapType::SizeType{ { 7, 6, 5 } }, false);
+    labels->Allocate(true);
+    for (itk::ImageRegionIteratorWithIndex<LabelMapType> it(labels, labels->GetLargestPossibleRegion()); !it.IsAtEnd();
+         ++it)
+      it.Set(it.GetIndex()[2] == 1 ? 2 : (it.GetIndex()[0] == 0 ? 300 : 0));
+    WriteWithItk<LabelMapType>(labels, (dir / "labels.mha").string(), true);
+    WriteText(dir / "labels.txt", "2 bladder\n300 bones\n");
+    auto mask = MaskType::New();
+    SetGeometry(mask.GetPointer(), MaskType::SizeType{ { 7, 6, 5 } }, false);
+    mask->Allocate(true);
+    for (itk::ImageRegionIteratorWithIndex<MaskType> it(mask, mask->GetLargestPossibleRegion()); !it.IsAtEnd(); ++it)
+      it.Set(it.GetIndex()[1] >= 3 ? 1 : 0);
+    WriteWithItk<MaskType>(mask, (dir / "bladder_mask.mha").string());
+    WriteText(dir / "bladder_points.txt", "point\n2\n-8.25 23.375 105.125\n-7.5 24.0 106.0\n");
+    const std::string labelPath = (dir / "labels.mha").string();
+    sources = { { "bladder", true, labelPath + ":bladder" },
+                { "bones", true, labelPath + ":300" },
+                { "bladder", false, (dir / "bladder_mask.mha").string() },
+                { "bones", false, labelPath + ":bones" },
+                { "bladder", false, (dir / "bladder_points.txt").string() } };
+  }
+
+  RegistrationProblem
+  Images() const
+  {
+    RegistrationProblem problem;
+    problem.LoadImages((dir / "fixed.mha").string(), (dir / "moving.mha").string());
+    return problem;
+  }
+};
+
+void
+ExpectSameMask(const MaskType * a, const MaskType * b, const std::string & what)
+{
+  ASSERT_EQ(a == nullptr, b == nullptr) << what;
+  if (a == nullptr)
+    return;
+  ASSERT_TRUE(SameGrid(a, b)) << what;
+  itk::ImageRegionConstIterator<MaskType> ia(a, a->GetLargestPossibleRegion()), ib(b, b->GetLargestPossibleRegion());
+  std::size_t                             differ = 0, inside = 0;
+  for (; !ia.IsAtEnd(); ++ia, ++ib)
+  {
+    differ += ia.Get() != ib.Get();
+    inside += ia.Get() != 0;
+  }
+  EXPECT_EQ(differ, 0u) << what;
+  EXPECT_GT(inside, 0u) << what;
+}
+} // namespace
+
+// Loading all sides at once gives what loading them one at a time gives:
+// the same structures in the same order, masks, and points (a point file
+// after a mask adds its points to the side).
+TEST(RegistrationProblemLoading, StructuresAtOnceMatchOneAtATime)
+{
+  const StructureFiles files;
+  RegistrationProblem  serial = files.Images();
+  for (const auto & s : files.sources)
+    serial.LoadStructure(s.name, s.fixedSide, s.source);
+  RegistrationProblem together = files.Images();
+  together.LoadStructures(files.sources);
+  ExpectSameValues<ImageType>(serial.fixedImage, together.fixedImage);
+  ExpectSameValues<ImageType>(serial.movingImage, together.movingImage);
+  EXPECT_EQ(together.movingImage->GetPixel({ { 0, 0, 0 } }), serial.fixedImage->GetPixel({ { 0, 0, 0 } }) + 5.0f);
+  ASSERT_EQ(together.structures.size(), 2u);
+  ASSERT_EQ(serial.structures.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i)
+  {
+    const Structure & a = serial.structures[i];
+    const Structure & b = together.structures[i];
+    EXPECT_EQ(a.name, b.name);
+    ExpectSameMask(a.fixedMask, b.fixedMask, a.name + " fixed");
+    ExpectSameMask(a.movingMask, b.movingMask, a.name + " moving");
+    EXPECT_EQ(a.fixedPoints.size(), b.fixedPoints.size());
+    ASSERT_EQ(a.movingPoints.size(), b.movingPoints.size());
+    for (std::size_t k = 0; k < a.movingPoints.size(); ++k)
+      EXPECT_EQ(a.movingPoints[k], b.movingPoints[k]);
+  }
+  EXPECT_EQ(together.GetStructure("bladder").movingPoints.size(), 2u);
+  EXPECT_TRUE(together.GetStructure("bladder").movingMask.IsNotNull()) << "the points kept the mask";
+  EXPECT_NO_THROW(together.Validate());
+}
+
+// The first failing source in the given order is the one reported, with
+// its structure's name and side, however the reads finish.
+TEST(RegistrationProblemLoading, TheFirstFailingSourceIsReported)
+{
+  const StructureFiles files;
+  auto                 sources = files.sources;
+  sources.insert(sources.begin() + 1, { "rectum", false, (files.dir / "labels.mha").string() + ":7" });
+  sources.push_back({ "liver", true, (files.dir / "nowhere.mha").string() });
+  RegistrationProblem problem = files.Images();
+  const std::string   message = ItkError([&] { problem.LoadStructures(sources); });
+  EXPECT_CONTAINS(message, "structure 'rectum' (moving)");
+  EXPECT_CONTAINS(message, "label 7");
+  sources.erase(sources.begin() + 1);
+  RegistrationProblem again = files.Images();
+  EXPECT_CONTAINS(ItkError([&] { again.LoadStructures(sources); }), "nowhere.mha");
+  RegistrationProblem noImages;
+  EXPECT_CONTAINS(ItkError([&] { noImages.LoadStructures(files.sources); }), "before its structures");
 }

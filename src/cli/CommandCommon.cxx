@@ -111,16 +111,19 @@ ProblemOptions::Load() const
   problem.LoadImages(fixedPath, movingPath);
   fixedSources.insert(fixedSources.end(), fixedStructures.begin(), fixedStructures.end());
   movingSources.insert(movingSources.end(), movingStructures.begin(), movingStructures.end());
+  // Every structure side at once (a label map named twice is read once).
+  std::vector<itk::morea::RegistrationProblem::StructureSource> structureSources;
   for (const auto & s : fixedSources)
   {
     const auto [name, source] = SplitAssignment(s, "--fixed-structure");
-    problem.LoadStructure(name, true, source);
+    structureSources.push_back({ name, true, source });
   }
   for (const auto & s : movingSources)
   {
     const auto [name, source] = SplitAssignment(s, "--moving-structure");
-    problem.LoadStructure(name, false, source);
+    structureSources.push_back({ name, false, source });
   }
+  problem.LoadStructures(structureSources);
   if (!fixedBodyPath.empty())
     problem.LoadBodyMask(true, fixedBodyPath);
   if (!movingBodyPath.empty())

@@ -1,5 +1,6 @@
 #include "itkRegistrationProblem.h"
 
+#include "itkImageIOFactory.h"
 #include "itkImageRegionConstIterator.h"
 #include "itkLandmarkIO.h"
 #include "itkMOREAImageIO.h"
@@ -7,8 +8,12 @@
 #include "itkRTStructureSetIO.h"
 
 #include <algorithm>
+#include <exception>
 #include <filesystem>
 #include <fstream>
+#include <future>
+#include <map>
+#include <mutex>
 
 namespace fs = std::filesystem;
 
@@ -71,22 +76,52 @@ SideName(bool fixedSide)
 {
   return fixedSide ? "fixed" : "moving";
 }
+
+/** An RTSTRUCT file or folder and an ROI name. */
+bool
+IsStructureSet(const std::string & path, const std::string & selector)
+{
+  return (fs::is_directory(path) || IsDicomFile(path)) && !selector.empty();
+}
+
+/** Sets ITK's IO factories up on this thread, before readers on several
+ *  threads ask for them (a header read: a DICOM folder needs none). */
+void
+PrepareConcurrentReads(const std::string & path)
+{
+  if (!fs::is_directory(path))
+    ImageIOFactory::CreateImageIO(path.c_str(), ImageIOFactory::ReadMode);
+}
 } // namespace
 
 void
 RegistrationProblem::LoadImages(const std::string & fixedPath, const std::string & movingPath)
 {
-  fixedImage = ReadImage(fixedPath);
-  movingImage = ReadImage(movingPath);
+  // Side by side: inflating their voxels is most of the loading.
+  PrepareConcurrentReads(fixedPath);
+  auto moving = std::async(std::launch::async, [&movingPath] { return ReadImage(movingPath); });
+  ImageType::Pointer fixed;
+  try
+  {
+    fixed = ReadImage(fixedPath);
+  }
+  catch (...)
+  {
+    moving.wait(); // its thread reads movingPath: let it end first
+    throw;
+  }
+  movingImage = moving.get();
+  fixedImage = fixed;
 }
 
 MaskType::Pointer
-RegistrationProblem::LoadMask(const std::string & source, const ImageType * grid, PointListType * contourPoints) const
+RegistrationProblem::LoadMask(const std::string & source, const ImageType * grid, PointListType * contourPoints,
+                              const LabelMapReader & readLabels) const
 {
   std::string path, selector;
   SplitSource(source, path, selector);
   MaskType::Pointer mask;
-  if ((fs::is_directory(path) || IsDicomFile(path)) && !selector.empty())
+  if (IsStructureSet(path, selector))
   {
     const auto   rois = ReadRTStructureSet(path);
     const auto & roi = FindROI(rois, selector);
@@ -97,7 +132,7 @@ RegistrationProblem::LoadMask(const std::string & source, const ImageType * grid
   }
   if (!selector.empty())
   {
-    auto         labels = ReadLabelMap(path);
+    auto         labels = readLabels ? readLabels(path) : ReadLabelMap(path);
     unsigned int value = 0;
     const bool   numeric = !selector.empty() && std::all_of(selector.begin(), selector.end(), ::isdigit);
     if (numeric)
@@ -136,34 +171,140 @@ RegistrationProblem::LoadMask(const std::string & source, const ImageType * grid
 void
 RegistrationProblem::LoadStructure(const std::string & name, bool fixedSide, const std::string & source)
 {
-  const ImageType * grid = fixedSide ? fixedImage.GetPointer() : movingImage.GetPointer();
-  if (grid == nullptr)
-    Fail("load the " + std::string(SideName(fixedSide)) + " image before its structures");
-  if (name.empty())
-    Fail("structure from '" + source + "' has no name");
-  Structure * s = FindStructure(name);
-  if (s == nullptr)
+  LoadStructures({ StructureSource{ name, fixedSide, source } });
+}
+
+Structure &
+RegistrationProblem::StructureNamed(const std::string & name)
+{
+  if (Structure * s = FindStructure(name))
+    return *s;
+  structures.push_back(Structure{});
+  structures.back().name = name;
+  return structures.back();
+}
+
+bool
+RegistrationProblem::LoadSide(const std::string & source, const ImageType * grid, MaskType::Pointer & mask,
+                              PointListType & points, const LabelMapReader & readLabels) const
+{
+  std::string path, selector;
+  SplitSource(source, path, selector);
+  if (selector.empty() && IsPointFile(path))
   {
-    structures.push_back(Structure{});
-    s = &structures.back();
-    s->name = name;
+    points = ReadLandmarks(path, grid);
+    return true;
   }
-  MaskType::Pointer & mask = fixedSide ? s->fixedMask : s->movingMask;
-  PointListType &     points = fixedSide ? s->fixedPoints : s->movingPoints;
-  try
+  mask = LoadMask(source, grid, &points, readLabels);
+  return IsStructureSet(path, selector); // LoadMask gave its contour points
+}
+
+void
+RegistrationProblem::LoadStructures(const std::vector<StructureSource> & sources)
+{
+  for (const StructureSource & s : sources)
+  {
+    if ((s.fixedSide ? fixedImage : movingImage).IsNull())
+      Fail("load the " + std::string(SideName(s.fixedSide)) + " image before its structures");
+    if (s.name.empty())
+      Fail("structure from '" + s.source + "' has no name");
+  }
+  if (sources.empty())
+    return;
+  // Label maps that several sources name are read once, on the first
+  // thread that asks; the others wait for it.
+  std::mutex                                                       labelMutex;
+  std::map<std::string, std::shared_future<LabelMapType::Pointer>> labelMaps;
+  const LabelMapReader readLabels = [&labelMutex, &labelMaps](const std::string & path) {
+    std::promise<LabelMapType::Pointer>     promise;
+    std::shared_future<LabelMapType::Pointer> future;
+    bool                                      reader = false;
+    {
+      std::lock_guard<std::mutex> lock(labelMutex);
+      auto                        found = labelMaps.find(path);
+      if (found == labelMaps.end())
+      {
+        found = labelMaps.emplace(path, promise.get_future().share()).first;
+        reader = true;
+      }
+      future = found->second;
+    }
+    if (reader)
+    {
+      try
+      {
+        promise.set_value(ReadLabelMap(path));
+      }
+      catch (...)
+      {
+        promise.set_exception(std::current_exception());
+      }
+    }
+    return future.get();
+  };
+  // Each side into its own result, side by side, then kept in order.
+  struct Loaded
+  {
+    MaskType::Pointer mask;
+    PointListType     points;
+    bool              pointsSet{ false }; ///< a point file or an RTSTRUCT's contours: they replace the side's points
+  };
+  for (const StructureSource & s : sources)
   {
     std::string path, selector;
-    SplitSource(source, path, selector);
-    if (selector.empty() && IsPointFile(path))
+    try
     {
-      points = ReadLandmarks(path, grid);
-      return;
+      SplitSource(s.source, path, selector);
     }
-    mask = LoadMask(source, grid, &points);
+    catch (const ExceptionObject &)
+    {
+      continue; // its own task reports it
+    }
+    if (fs::is_regular_file(path))
+    {
+      PrepareConcurrentReads(path);
+      break;
+    }
   }
-  catch (const ExceptionObject & e)
+  std::vector<Loaded>             loaded(sources.size());
+  std::vector<std::future<void>>  tasks;
+  std::vector<std::exception_ptr> errors(sources.size());
+  for (std::size_t i = 0; i < sources.size(); ++i)
+    tasks.push_back(std::async(std::launch::async, [&, i] {
+      const StructureSource & s = sources[i];
+      try
+      {
+        loaded[i].pointsSet = LoadSide(s.source, s.fixedSide ? fixedImage.GetPointer() : movingImage.GetPointer(),
+                                       loaded[i].mask, loaded[i].points, readLabels);
+      }
+      catch (...)
+      {
+        errors[i] = std::current_exception();
+      }
+    }));
+  for (auto & t : tasks)
+    t.wait();
+  for (std::size_t i = 0; i < sources.size(); ++i)
+    if (errors[i])
+    {
+      const StructureSource & s = sources[i];
+      try
+      {
+        std::rethrow_exception(errors[i]);
+      }
+      catch (const ExceptionObject & e)
+      {
+        Fail("structure '" + s.name + "' (" + SideName(s.fixedSide) + "): " + e.GetDescription());
+      }
+    }
+  for (std::size_t i = 0; i < sources.size(); ++i)
   {
-    Fail("structure '" + name + "' (" + SideName(fixedSide) + "): " + e.GetDescription());
+    Structure & structure = StructureNamed(sources[i].name);
+    const bool  fixedSide = sources[i].fixedSide;
+    if (loaded[i].mask)
+      (fixedSide ? structure.fixedMask : structure.movingMask) = loaded[i].mask;
+    if (loaded[i].pointsSet)
+      (fixedSide ? structure.fixedPoints : structure.movingPoints) = std::move(loaded[i].points);
   }
 }
 
