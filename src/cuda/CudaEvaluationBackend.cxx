@@ -171,7 +171,8 @@ struct BatchFlight
 
   cuda::Event start, staged, end;
   cuda::Event rangeStart[MaxRanges], rangeUploaded[MaxRanges];
-  /** Per part, PartStep apart: its fold checks, its sampling's set-up and its sampling, each start and end. */
+  /** Per part, PartStep apart: its fold checks, its sampling's set-up and its sampling, each start and end;
+   *  the end of its values. */
   std::vector<std::unique_ptr<cuda::Event>> partEvents;
   std::vector<std::unique_ptr<cuda::Event>> copiedEvents; ///< per part: its values on the host
 
@@ -188,6 +189,7 @@ struct BatchFlight
     SetUpEnd,
     SamplingStart,
     SamplingEnd,
+    ValuesEnd, ///< the candidates' sums too: what the copy back waits for
     PartSteps
   };
   cudaEvent_t
@@ -1482,6 +1484,7 @@ private:
                                      f.tetrahedra.Data() + begin, f.skipItems ? f.itemSkip.Data() + begin : nullptr,
                                      count, itemValues, directionValues, stream);
     }
+    Check(cudaEventRecord(f.PartEvent(p, BatchFlight::SamplingEnd), stream), "recording an event");
     // A batch of candidates (not whole solutions): each one's sum.
     const std::size_t firstCandidate = f.candidateBounds[p], endCandidate = f.candidateBounds[p + 1];
     if (f.skipItems && endCandidate > firstCandidate)
@@ -1492,10 +1495,10 @@ private:
       cuda::LaunchSumCandidateValues(part, f.itemValues.Data(), f.directionValues.Data(), f.candidateSums.Data(),
                                      stream);
     }
-    Check(cudaEventRecord(f.PartEvent(p, BatchFlight::SamplingEnd), stream), "recording an event");
+    Check(cudaEventRecord(f.PartEvent(p, BatchFlight::ValuesEnd), stream), "recording an event");
     // The values go back on the copy stream, so that the next part's
     // kernels do not wait for the transfer (about 70 bytes per tetrahedron).
-    Check(cudaStreamWaitEvent(copies, f.PartEvent(p, BatchFlight::SamplingEnd), 0), "ordering a copy after its part");
+    Check(cudaStreamWaitEvent(copies, f.PartEvent(p, BatchFlight::ValuesEnd), 0), "ordering a copy after its part");
     Check(cudaMemcpyAsync(f.hostItemValues.Data() + begin * cuda::ItemValues, itemValues,
                           count * cuda::ItemValues * sizeof(double), cudaMemcpyDeviceToHost, copies),
           "copying values from the device");
