@@ -8,12 +8,14 @@
 #include "itkRTStructureSetIO.h"
 
 #include <algorithm>
+#include <atomic>
 #include <exception>
 #include <filesystem>
 #include <fstream>
 #include <future>
 #include <map>
 #include <mutex>
+#include <thread>
 
 namespace fs = std::filesystem;
 
@@ -267,19 +269,25 @@ RegistrationProblem::LoadStructures(const std::vector<StructureSource> & sources
     }
   }
   std::vector<Loaded>             loaded(sources.size());
+  // At most one reader per core, each taking the next source in turn.
   std::vector<std::future<void>>  tasks;
   std::vector<std::exception_ptr> errors(sources.size());
-  for (std::size_t i = 0; i < sources.size(); ++i)
-    tasks.push_back(std::async(std::launch::async, [&, i] {
-      const StructureSource & s = sources[i];
-      try
+  std::atomic<std::size_t>        next{ 0 };
+  const std::size_t readers = std::min<std::size_t>(sources.size(), std::max(1u, std::thread::hardware_concurrency()));
+  for (std::size_t r = 0; r < readers; ++r)
+    tasks.push_back(std::async(std::launch::async, [&] {
+      for (std::size_t i = next++; i < sources.size(); i = next++)
       {
-        loaded[i].pointsSet = LoadSide(s.source, s.fixedSide ? fixedImage.GetPointer() : movingImage.GetPointer(),
-                                       loaded[i].mask, loaded[i].points, readLabels);
-      }
-      catch (...)
-      {
-        errors[i] = std::current_exception();
+        const StructureSource & s = sources[i];
+        try
+        {
+          loaded[i].pointsSet = LoadSide(s.source, s.fixedSide ? fixedImage.GetPointer() : movingImage.GetPointer(),
+                                         loaded[i].mask, loaded[i].points, readLabels);
+        }
+        catch (...)
+        {
+          errors[i] = std::current_exception();
+        }
       }
     }));
   for (auto & t : tasks)
