@@ -309,12 +309,7 @@ public:
     });
     CopyCornersToDevice(f, items);
     RunWhole(f, items);
-    std::vector<std::uint64_t> first(solutions.size() + 1);
-    for (std::size_t s = 0; s <= solutions.size(); ++s)
-      first[s] = s * n;
-    for (auto * v : values)
-      v->resize(n);
-    UnpackRange(f, first.data(), 0, solutions.size(), [&](std::size_t s) { return values[s]->data(); });
+    UnpackSolutions(f, n, values);
     m_Statistics.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
 
@@ -476,7 +471,7 @@ public:
   {
     const auto                 start = std::chrono::steady_clock::now();
     const HostCandidates &     h = m_HostCandidates[m_CurrentHost];
-    const BatchFlight &        f = *m_Flights[m_CurrentHost];
+    BatchFlight &              f = *m_Flights[m_CurrentHost];
     std::size_t                count = 0;
     for (std::size_t i : which)
     {
@@ -570,7 +565,7 @@ public:
     {
       const PartialCandidate & c = candidates[i];
       UnpackValues(f, h.firstItem.Data(), i, c);
-      m_Flights[m_CurrentHost]->valuesWritten[i] = 1;
+      f.valuesWritten[i] = 1;
       double                   samples = 0.0;
       for (std::size_t k = 0; k < c.element->dependentTetrahedra.size(); ++k, ++at)
       {
@@ -1678,47 +1673,23 @@ private:
     return itemsLeftAlone;
   }
 
-  /** Unpacks items [first[i], first[i + 1]) of flight `f` into out(i) for
-   *  every i in [begin, end) on the pool, counting the samples on the way; a
-   *  group whose out(i) is null is left alone. Groups whose `spared` entry
-   *  is set (null: none) were not sampled (refusal bound): their samples
-   *  count as spared. Returns the number of items left alone. */
-  template <typename Output>
-  std::uint64_t
-  UnpackRange(const BatchFlight & f, const std::uint64_t * first, std::size_t begin, std::size_t end, Output out,
-              const std::uint32_t * spared = nullptr)
+  /** Unpacks whole solutions' values from flight `f` (n items each, in
+   *  solution order) on the pool, counting their samples. */
+  void
+  UnpackSolutions(const BatchFlight & f, std::size_t n, const std::vector<std::vector<TetrahedronValues> *> & values)
   {
-    std::vector<double>       samples(end - begin, 0.0);
-    std::vector<std::uint8_t> leftAlone(end - begin, 0);
-    m_Pool->ParallelFor(end - begin, [&](std::size_t g) {
-      const std::size_t   i = begin + g;
-      TetrahedronValues * o = out(i);
-      if (o == nullptr)
+    std::vector<double> samples(values.size(), 0.0);
+    m_Pool->ParallelFor(values.size(), [&](std::size_t s) {
+      std::vector<TetrahedronValues> & out = *values[s];
+      out.resize(n);
+      for (std::size_t t = 0; t < n; ++t)
       {
-        leftAlone[g] = 1;
-        return;
-      }
-      for (std::size_t item = first[i]; item < first[i + 1]; ++item)
-      {
-        *o = Unpack(f, item);
-        samples[g] += o->samples;
-        ++o;
+        out[t] = Unpack(f, s * n + t);
+        samples[s] += out[t].samples;
       }
     });
-    std::uint64_t itemsLeftAlone = 0;
-    for (std::size_t g = 0; g < samples.size(); ++g)
-    {
-      if (leftAlone[g])
-        itemsLeftAlone += first[begin + g + 1] - first[begin + g];
-      if (spared && spared[begin + g])
-      {
-        ++m_Statistics.boundSkipped;
-        m_Statistics.boundSkippedSamples += samples[g];
-      }
-      else
-        m_Statistics.samples += samples[g];
-    }
-    return itemsLeftAlone;
+    for (double count : samples)
+      m_Statistics.samples += count;
   }
 
   const TetrahedronEvaluator &  m_Evaluator;

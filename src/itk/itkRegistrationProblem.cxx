@@ -1,6 +1,6 @@
 #include "itkRegistrationProblem.h"
 
-#include "itkImageIOFactory.h"
+#include "itkObjectFactoryBase.h"
 #include "itkImageRegionConstIterator.h"
 #include "itkLandmarkIO.h"
 #include "itkMOREAImageIO.h"
@@ -87,12 +87,11 @@ IsStructureSet(const std::string & path, const std::string & selector)
 }
 
 /** Sets ITK's IO factories up on this thread, before readers on several
- *  threads ask for them (a header read: a DICOM folder needs none). */
+ *  threads ask for them. */
 void
-PrepareConcurrentReads(const std::string & path)
+PrepareConcurrentReads()
 {
-  if (!fs::is_directory(path))
-    ImageIOFactory::CreateImageIO(path.c_str(), ImageIOFactory::ReadMode);
+  ObjectFactoryBase::CreateAllInstance("itkImageIOBase");
 }
 } // namespace
 
@@ -100,7 +99,7 @@ void
 RegistrationProblem::LoadImages(const std::string & fixedPath, const std::string & movingPath)
 {
   // Side by side: inflating their voxels is most of the loading.
-  PrepareConcurrentReads(fixedPath);
+  PrepareConcurrentReads();
   auto moving = std::async(std::launch::async, [&movingPath] { return ReadImage(movingPath); });
   ImageType::Pointer fixed;
   try
@@ -251,23 +250,7 @@ RegistrationProblem::LoadStructures(const std::vector<StructureSource> & sources
     PointListType     points;
     bool              pointsSet{ false }; ///< a point file or an RTSTRUCT's contours: they replace the side's points
   };
-  for (const StructureSource & s : sources)
-  {
-    std::string path, selector;
-    try
-    {
-      SplitSource(s.source, path, selector);
-    }
-    catch (const ExceptionObject &)
-    {
-      continue; // its own task reports it
-    }
-    if (fs::is_regular_file(path))
-    {
-      PrepareConcurrentReads(path);
-      break;
-    }
-  }
+  PrepareConcurrentReads();
   std::vector<Loaded>             loaded(sources.size());
   // At most one reader per core, each taking the next source in turn.
   std::vector<std::future<void>>  tasks;
