@@ -22,6 +22,10 @@
 #                  generations (bench/tools/main-thread-profiler.c); here,
 #                  bench/tools/profile-report.py OUTDIR/main-thread.prof --binary build/bin/morea
 #                  names the functions (with the build the bundle was made from).
+#   While the device waits: bench/run-device-benchmark.sh timeline OUTDIR SECONDS BACKEND GENERATIONS
+#                  [morea benchmark options] records the device's timeline (CUPTI) and the main
+#                  thread's stacks on one clock; bench/tools/device-gaps.py lists the idle gaps and
+#                  profile-report.py --during shows what the main thread did in them.
 #   Whole runs: bench/run-device-benchmark.sh whole OUTDIR SECONDS BACKEND LABEL PROGRAM [OPTIONS]
 #                  registers from scratch with PROGRAM (e.g. /tmp/b/bin/morea-old) and OPTIONS.
 #   Late generations of several builds: bench/run-device-benchmark.sh late-ab OUTDIR SECONDS BACKEND
@@ -87,7 +91,16 @@ case "${1:-}" in
     cp "$DATA"/CB02.mha "$DATA"/CB07.mha "$DATA"/CB02_labels.mha "$DATA"/CB02_labels.txt "$stage/abdomen/"
     cp "$DATA"/CB07_masks/Stomach_duo_CBCT.mha "$DATA"/CB07_masks/Bowel_sm_CBCT.mha "$stage/abdomen/CB07_masks/"
     cc -O2 -shared -fPIC -o "$stage/main-thread-profiler.so" bench/tools/main-thread-profiler.c
-    scripts/device-bundle.sh --data "$stage/abdomen" --lib "$stage/main-thread-profiler.so" \
+    libs=(--lib "$stage/main-thread-profiler.so")
+    # The timeline tracer, where CUPTI is installed (it travels along).
+    cuda=$(dirname "$(dirname "$(readlink -f "$(command -v nvcc)")")")
+    cupti=$(ls "$cuda"/lib/libcupti.so.* "$cuda"/lib64/libcupti.so.* "$cuda"/extras/CUPTI/lib64/libcupti.so.* 2>/dev/null | head -1 || true)
+    if [ -n "$cupti" ]; then
+      cc -O2 -shared -fPIC -o "$stage/device-timeline.so" bench/tools/device-timeline.c -I "$cuda/include" \
+        -I "$cuda/extras/CUPTI/include" "$cupti"
+      libs+=(--lib "$stage/device-timeline.so" --lib "$cupti")
+    fi
+    scripts/device-bundle.sh --data "$stage/abdomen" "${libs[@]}" \
       build/bin/morea build/test/MOREACoreTests "${@:2}"
     ;;
   run)
@@ -230,6 +243,31 @@ EOF2
       -o "$out/profiled.json" "$@" > "$out/profiled.log" 2>&1
     summary "$out/profiled.json" "$backend" profiled
     ;;
+  timeline)
+    # What the main thread does while the device stands idle: GENERATIONS
+    # late generations from a checkpoint of SECONDS, with the device's
+    # timeline (bench/tools/device-timeline.c) and the main thread's stacks
+    # (main-thread-profiler.c) on one clock. OUTDIR gets the gaps' summary
+    # (device-gaps.py), the gaps and the profile; here,
+    # bench/tools/profile-report.py OUTDIR/main-thread.prof --binary build/bin/morea --during OUTDIR/gaps.txt
+    out=${2:?output folder}
+    seconds=${3:?seconds of the start}
+    backend=${4:?backend}
+    generations=${5:?generations}
+    shift 5
+    mkdir -p "$out" /tmp/ab
+    unpack_bundle
+    [ -f /tmp/ab/profile/checkpoint.bin ] || register /tmp/b/bin/morea /tmp/ab/profile "$seconds" cuda-texture || true
+    MOREA_TIMELINE=/tmp/ab/timeline.txt MOREA_PROFILE="$out/main-thread.prof" MOREA_PROFILE_HZ=2000 \
+      LD_PRELOAD="/tmp/b/lib/device-timeline.so /tmp/b/lib/main-thread-profiler.so" \
+      /tmp/b/bin/morea benchmark "${PROBLEM[@]}" --backends "$backend" --generations "$generations" --probe 0 \
+      --from-checkpoint /tmp/ab/profile/checkpoint.bin -o "$out/timeline.json" "$@" > "$out/timeline.log" 2>&1
+    summary "$out/timeline.json" "$backend" timeline
+    # The first seconds load the checkpoint and evaluate its population.
+    python3 bench/tools/device-gaps.py /tmp/ab/timeline.txt --from-seconds "${MOREA_TIMELINE_SKIP:-1}" \
+      --write-gaps "$out/gaps.txt" | tee "$out/gaps-summary.txt"
+    xz -T0 -c /tmp/ab/timeline.txt > "$out/timeline.txt.xz"
+    ;;
   late-ab)
     # Several programs over the same late generations: the bundle's morea
     # registers for SECONDS, then each PROGRAM times GENERATIONS from that
@@ -327,6 +365,7 @@ EOF2
       "| ab OUTDIR SECONDS BACKEND PROGRAM... | late OUTDIR SECONDS BACKEND [GENERATIONS]" \
       "| early OUTDIR GENERATIONS ROUNDS BACKEND PROGRAM... | profile OUTDIR SECONDS BACKEND GENERATIONS [OPTIONS]" \
       "| bound OUTDIR SECONDS BACKEND GENERATIONS [ROUNDS [PROGRAM...]]" \
+      "| timeline OUTDIR SECONDS BACKEND GENERATIONS [OPTIONS]" \
       "| whole OUTDIR SECONDS BACKEND LABEL PROGRAM [OPTIONS] | command OUTDIR ROUNDS BACKEND PROGRAM..." >&2
     exit 2
     ;;

@@ -6,7 +6,9 @@
  * waits, so the samples show where the main thread's wall time goes,
  * waits on the device included. Each sample's call stack (return
  * addresses) is kept in memory and written at exit with /proc/self/maps;
- * bench/tools/profile-report.py names the functions.
+ * bench/tools/profile-report.py names the functions. Each sample's "s" line
+ * follows a "t" line with its CLOCK_MONOTONIC time in nanoseconds (the clock
+ * of device-timeline.c's records).
  *   cc -O2 -shared -fPIC -o main-thread-profiler.so main-thread-profiler.c
  */
 #define _GNU_SOURCE
@@ -28,6 +30,7 @@ enum
 
 static void ** g_Frames;
 static unsigned char * g_Depths;
+static unsigned long long * g_Times;
 static volatile long g_Count;
 static long g_Dropped;
 static timer_t g_Timer;
@@ -44,6 +47,9 @@ OnTick(int signal)
     return;
   }
   const int saved = errno;
+  struct timespec now;
+  clock_gettime(CLOCK_MONOTONIC, &now);
+  g_Times[i] = (unsigned long long)now.tv_sec * 1000000000ull + (unsigned long long)now.tv_nsec;
   g_Depths[i] = (unsigned char)backtrace(g_Frames + (size_t)i * MaxFrames, MaxFrames);
   g_Count = i + 1;
   errno = saved;
@@ -59,7 +65,8 @@ StartProfile(void)
   const long   hz = hzText ? atol(hzText) : 500;
   g_Frames = malloc(sizeof(void *) * (size_t)MaxFrames * MaxSamples);
   g_Depths = malloc(MaxSamples);
-  if (!g_Frames || !g_Depths || hz <= 0 || hz > 100000)
+  g_Times = malloc(sizeof(unsigned long long) * MaxSamples);
+  if (!g_Frames || !g_Depths || !g_Times || hz <= 0 || hz > 100000)
   {
     fprintf(stderr, "main-thread-profiler: cannot start (memory or MOREA_PROFILE_HZ)\n");
     return;
@@ -107,6 +114,7 @@ WriteProfile(void)
           getenv("MOREA_PROFILE_HZ") ? getenv("MOREA_PROFILE_HZ") : "500");
   for (long i = 0; i < g_Count; ++i)
   {
+    fprintf(out, "t %llu\n", g_Times[i]);
     fputc('s', out);
     for (int k = 0; k < g_Depths[i]; ++k)
       fprintf(out, " %lx", (unsigned long)g_Frames[(size_t)i * MaxFrames + k]);

@@ -2,6 +2,7 @@
 """Names the functions in a profile written by main-thread-profiler.c.
 
   profile-report.py PROFILE [--binary PATH]... [--under TEXT] [--callers-of TEXT] [--skip FRACTION] [--top N]
+                    [--during INTERVALS]
 
 PROFILE holds the sampled call stacks' return addresses and the process's
 memory map. Each address is resolved against a local, unstripped copy of the
@@ -9,7 +10,10 @@ binary it fell in (--binary, matched by file name; the build the bundle was
 stripped from), or else named by its library. Prints the share of samples
 per function as the innermost frame (self) and anywhere on the stack
 (inclusive); with --under, only samples whose stack holds a function whose
-name contains TEXT, with the functions called directly below it.
+name contains TEXT, with the functions called directly below it. With
+--during, only samples taken within the intervals a file lists (one
+"START END" line each, CLOCK_MONOTONIC nanoseconds, as device-gaps.py writes
+the device's idle gaps).
 """
 import argparse
 import bisect
@@ -52,14 +56,20 @@ def main():
     parser.add_argument("--depth", type=int, default=0,
                         help="with --lines: the line this many inlined calls inside that frame's own")
     parser.add_argument("--top", type=int, default=40)
+    parser.add_argument("--during", help="a file of START END lines (ns): only samples taken within them")
     args = parser.parse_args()
 
-    stacks, maps = [], []
+    stacks, times, maps = [], [], []
+    time = None
     with open(args.profile) as f:
         header = f.readline().strip()
         for line in f:
-            if line.startswith("s"):
+            if line.startswith("t "):
+                time = int(line.split()[1])
+            elif line.startswith("s"):
                 stacks.append([int(a, 16) for a in line.split()[1:]])
+                times.append(time)
+                time = None
             elif line.startswith("m "):
                 p = line[2:].split()
                 if len(p) >= 6 and "x" in p[1]:
@@ -96,6 +106,15 @@ def main():
     def name(address):
         return locate(address)[2]
 
+    if args.during:
+        spans = sorted(tuple(int(v) for v in line.split()[:2]) for line in open(args.during) if line.strip())
+        begins = [b for b, _ in spans]
+
+        def within(t):
+            i = bisect.bisect_right(begins, t) - 1 if t is not None else -1
+            return i >= 0 and t < spans[i][1]
+
+        stacks = [st for st, t in zip(stacks, times) if within(t)]
     samples, addresses = [], []
     for stack in stacks:
         # Frames 0 and 1 are the signal handler and the kernel's return

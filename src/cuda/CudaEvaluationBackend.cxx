@@ -95,15 +95,24 @@ struct HostCandidates
     return { c.parent, c.element, c.source, c.target, c.folds, c.seed };
   }
 
+  /** On the pool, in blocks: a batch's tens of thousands of candidates lie
+   *  far apart in memory, and comparing them on the main thread alone took
+   *  about 4 ms of a late paper-scale generation on an H100 host (two or
+   *  three calls per batch). */
   bool
-  PackedFor(const std::vector<PartialCandidate> & candidates) const
+  PackedFor(const std::vector<PartialCandidate> & candidates, ThreadPool & pool) const
   {
     if (!prepared || signatures.size() != candidates.size())
       return false;
-    for (std::size_t i = 0; i < candidates.size(); ++i)
-      if (!(signatures[i] == SignatureOf(candidates[i])))
-        return false;
-    return true;
+    constexpr std::size_t block = 2048;
+    std::atomic<bool>     same{ true };
+    pool.ParallelFor((candidates.size() + block - 1) / block, [&](std::size_t b) {
+      const std::size_t end = std::min(candidates.size(), (b + 1) * block);
+      for (std::size_t i = b * block; i < end && same.load(std::memory_order_relaxed); ++i)
+        if (!(signatures[i] == SignatureOf(candidates[i])))
+          same.store(false, std::memory_order_relaxed);
+    });
+    return same.load();
   }
 
   bool                           prepared{ false }; ///< by PrepareNextPartials, not yet used
@@ -366,7 +375,7 @@ public:
     BatchFlight &     f = *m_Flights[slot];
     const std::size_t n = candidates.size();
     // Its first candidates may be on the device already (StartNextPartials).
-    const bool started = m_Head.open && host.PackedFor(candidates);
+    const bool started = m_Head.open && host.PackedFor(candidates, *m_Pool);
     if (m_Head.open && !started) // its queued work reads what is packed afresh now
       Synchronize("abandoning a started batch");
     m_Head.open = false;
@@ -379,7 +388,7 @@ public:
     }
     else
     {
-      if (!host.PackedFor(candidates))
+      if (!host.PackedFor(candidates, *m_Pool))
         PackCandidates(candidates, host);
       BeginFlight(candidates, host, f, m_HasRefusalScreen ? &m_RefusalScreen : nullptr);
     }
@@ -424,7 +433,7 @@ public:
       return;
     const int        slot = 1 - m_CurrentHost;
     HostCandidates & h = m_HostCandidates[slot];
-    if (!h.PackedFor(next) || h.firstItem[next.size()] == 0 || h.largestChecked > cuda::MaxRepairElementPoints)
+    if (!h.PackedFor(next, *m_Pool) || h.firstItem[next.size()] == 0 || h.largestChecked > cuda::MaxRepairElementPoints)
       return;
     const auto    start = std::chrono::steady_clock::now();
     BatchFlight & f = *m_Flights[slot];
