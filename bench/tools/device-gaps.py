@@ -26,11 +26,30 @@ def short_names(mangled):
         out = subprocess.run(["c++filt"], input="\n".join(mangled), capture_output=True, text=True).stdout.splitlines()
         if len(out) == len(mangled):
             names = dict(zip(mangled, out))
+    def unmangled(m):
+        """The kernel's own name from an Itanium-mangled one, without c++filt:
+        after a file's anonymous namespace (..._cu_HASH) come the name's
+        length and the name; the hash may end in digits too, so each split of
+        the digits is tried."""
+        match = re.search(r"_cu_[0-9a-f]{8}(\d+)", m)
+        if match:
+            digits = match.group(1)
+            for cut in range(len(digits)):
+                n = int(digits[cut:])
+                name = m[match.end(1): match.end(1) + n]
+                if n > 0 and len(name) == n and name.isidentifier():
+                    return name
+        return m
+
     result = {}
     for m, n in names.items():
+        if n == m:
+            n = unmangled(m)
+        n = n.replace("(anonymous namespace)", "")
+        while re.search(r"<[^<>]*>", n):  # template arguments, innermost first
+            n = re.sub(r"<[^<>]*>", "", n)
         n = re.sub(r"\(.*", "", n)  # arguments
-        n = re.sub(r"<.*>", "", n)  # template arguments
-        result[m] = n.split("::")[-1] or m
+        result[m] = n.split("::")[-1].split()[-1] if n.strip() else m
     return result
 
 
