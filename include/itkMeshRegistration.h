@@ -63,7 +63,7 @@ struct MeshRegistrationResult
   std::size_t                            resumedAtGeneration{ 0 }; ///< 0 when started afresh
   double                                 secondsModel{ 0.0 }; ///< the three below together
   double                                 secondsMesh{ 0.0 };          ///< mesh model (points, tetrahedra, groups)
-  double                                 secondsObjectiveData{ 0.0 }; ///< images, distance maps, samples
+  double                                 secondsObjectiveData{ 0.0 }; ///< images, distance maps: what the mesh's time did not hide
   double                                 secondsBackend{ 0.0 };       ///< the backend made (device set-up)
   double                                 secondsOptimisation{ 0.0 };
 };

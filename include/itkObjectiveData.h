@@ -36,6 +36,12 @@ namespace morea
 BuildObjectiveData(const RegistrationProblem & problem, const MeshModel & model,
                    const ::morea::ParameterSet & parameters);
 
+/** The same in the frame `frame` (a model's frame is DomainFrame::Of(its moving
+ *  image)), without a model: RegisterMeshes makes it while the mesh is built. */
+::morea::ObjectiveData
+BuildObjectiveData(const RegistrationProblem & problem, const DomainFrame & frame,
+                   const ::morea::ParameterSet & parameters);
+
 /** Unsigned distance in mm from every voxel centre of `grid` to the structure's surface:
  *  from the mask when present and non-empty (signed Maurer distances with image spacing,
  *  combined so that the surface lies halfway between inside and outside voxel centres),

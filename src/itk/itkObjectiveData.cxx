@@ -231,6 +231,13 @@ StructureDistanceMap(const Structure & structure, bool fixedSide, const ImageBas
 BuildObjectiveData(const RegistrationProblem & problem, const MeshModel & model,
                    const ::morea::ParameterSet & parameters)
 {
+  return BuildObjectiveData(problem, model.frame, parameters);
+}
+
+::morea::ObjectiveData
+BuildObjectiveData(const RegistrationProblem & problem, const DomainFrame & frame,
+                   const ::morea::ParameterSet & parameters)
+{
   if (!problem.fixedImage || !problem.movingImage)
   {
     Fail("the problem has no images");
@@ -239,7 +246,7 @@ BuildObjectiveData(const RegistrationProblem & problem, const MeshModel & model,
   {
     Fail("the problem must be preprocessed (both images on one grid)");
   }
-  if (!model.frame.IsAlignedWith(problem.movingImage))
+  if (!frame.IsAlignedWith(problem.movingImage))
   {
     Fail("the mesh model's domain frame is not the images' frame");
   }
@@ -273,8 +280,8 @@ BuildObjectiveData(const RegistrationProblem & problem, const MeshModel & model,
     counts.push_back(static_cast<double>(movingCount));
   }
 
-  data.fixed = MakeChannelVolume(ToVolume(problem.fixedImage.GetPointer(), model.frame), 1 + guidance);
-  data.moving = MakeChannelVolume(ToVolume(problem.movingImage.GetPointer(), model.frame), 1 + guidance);
+  data.fixed = MakeChannelVolume(ToVolume(problem.fixedImage.GetPointer(), frame), 1 + guidance);
+  data.moving = MakeChannelVolume(ToVolume(problem.movingImage.GetPointer(), frame), 1 + guidance);
   // One grid (SameGrid allows rounding differences): both take the moving image's geometry bit for bit.
   data.fixed.origin = data.moving.origin;
   data.fixed.spacing = data.moving.spacing;
@@ -282,9 +289,9 @@ BuildObjectiveData(const RegistrationProblem & problem, const MeshModel & model,
   {
     // One map at a time: real grids hold tens of millions of voxels.
     SetChannel(data.fixed, 1 + g,
-               ToVolume(StructureDistanceMap(*structures[g], true, problem.fixedImage).GetPointer(), model.frame));
+               ToVolume(StructureDistanceMap(*structures[g], true, problem.fixedImage).GetPointer(), frame));
     SetChannel(data.moving, 1 + g,
-               ToVolume(StructureDistanceMap(*structures[g], false, problem.movingImage).GetPointer(), model.frame));
+               ToVolume(StructureDistanceMap(*structures[g], false, problem.movingImage).GetPointer(), frame));
   }
 
   double total = 0.0;
