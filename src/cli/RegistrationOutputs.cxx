@@ -229,6 +229,13 @@ WriteRegistrationOutputs(const itk::morea::PreprocessResult & preprocessed,
     return RasterizeSolution(result.model.topology, result.front[chosen[i].index].mesh, problem.fixedImage,
                              problem.movingImage);
   };
+  // The rigid baseline's scores while the first solutions' fields, transforms
+  // and meshes are made (they read the images' grids only); waited for before
+  // the solutions' own scores, so that no two pipelines share a mask.
+  std::future<EvaluationScores> baseline;
+  if (scored)
+    baseline = std::async(std::launch::async,
+                          [&problem, borderMargin] { return EvaluateRegistration(problem, nullptr, nullptr, borderMargin); });
   // Each solution's fields are made one solution ahead, so that its slow
   // .nii.gz writes start before the last solution's transforms, scores and
   // renders rather than after them; at most two solutions' fields are held.
@@ -267,6 +274,7 @@ WriteRegistrationOutputs(const itk::morea::PreprocessResult & preprocessed,
                                    { "moving_to_fixed", repairJson(fields.movingFoldRepair) } };
     if (scored)
     {
+      baseline.wait();
       const auto scores = EvaluateRegistration(problem, fields.fixedToMoving, fields.movingToFixed, borderMargin);
       entry["scores"] = ToJson(scores);
       if (trueFixedToMoving)
@@ -279,9 +287,8 @@ WriteRegistrationOutputs(const itk::morea::PreprocessResult & preprocessed,
     }
     summary["solutions"][c.label] = entry;
   }
-  // The baseline's scores while the last fields are written.
   if (scored)
-    summary["rigid_baseline"] = ToJson(EvaluateRegistration(problem, nullptr, nullptr, borderMargin));
+    summary["rigid_baseline"] = ToJson(baseline.get());
   lap(scoreSeconds);
   writes.Wait();
   lap(fileSeconds);
