@@ -64,6 +64,19 @@ unpack_bundle() {
   export LD_LIBRARY_PATH=/tmp/b/lib
 }
 
+# late_from_checkpoint OUTBASE SECONDS BACKEND GENERATIONS [OPTIONS]: `morea benchmark`
+# of GENERATIONS late generations from the checkpoint /tmp/ab/profile (registered for
+# SECONDS once per machine), under the LD_PRELOAD and MOREA_* variables the caller
+# sets (it starts no other program under them); OUTBASE.json and OUTBASE.log.
+late_from_checkpoint() {
+  local outbase=$1 seconds=${2:?seconds of the start} backend=${3:?backend} generations=${4:?generations}
+  shift 4
+  [ -f /tmp/ab/profile/checkpoint.bin ] ||
+    LD_PRELOAD= MOREA_PROFILE= MOREA_TIMELINE= register /tmp/b/bin/morea /tmp/ab/profile "$seconds" cuda-texture || true
+  /tmp/b/bin/morea benchmark "${PROBLEM[@]}" --backends "$backend" --generations "$generations" \
+    --cpu-generations "$generations" --threads 16 --probe 0 --from-checkpoint /tmp/ab/profile/checkpoint.bin \
+    -o "$outbase.json" "$@" > "$outbase.log" 2>&1
+}
 # summary JSON BACKEND NAME: one line of a `morea benchmark` run.
 summary() {
   python3 - "$1" "$2" "$3" <<'EOF'
@@ -230,18 +243,11 @@ EOF2
     # The main thread's call stacks, sampled 1000 times a second over
     # GENERATIONS late generations from a checkpoint of SECONDS.
     out=${2:?output folder}
-    seconds=${3:?seconds of the start}
-    backend=${4:?backend}
-    generations=${5:?generations}
-    shift 5
     mkdir -p "$out" /tmp/ab
     unpack_bundle
-    [ -f /tmp/ab/profile/checkpoint.bin ] || register /tmp/b/bin/morea /tmp/ab/profile "$seconds" cuda-texture || true
     MOREA_PROFILE="$out/main-thread.prof" MOREA_PROFILE_HZ=1000 LD_PRELOAD=/tmp/b/lib/main-thread-profiler.so \
-      /tmp/b/bin/morea benchmark "${PROBLEM[@]}" --backends "$backend" --generations "$generations" \
-      --cpu-generations "$generations" --threads 16 --probe 0 --from-checkpoint /tmp/ab/profile/checkpoint.bin \
-      -o "$out/profiled.json" "$@" > "$out/profiled.log" 2>&1
-    summary "$out/profiled.json" "$backend" profiled
+      late_from_checkpoint "$out/profiled" "${@:3}"
+    summary "$out/profiled.json" "$4" profiled
     ;;
   timeline)
     # What the main thread does while the device stands idle: GENERATIONS
@@ -251,18 +257,12 @@ EOF2
     # (device-gaps.py), the gaps and the profile; here,
     # bench/tools/profile-report.py OUTDIR/main-thread.prof --binary build/bin/morea --during OUTDIR/gaps.txt
     out=${2:?output folder}
-    seconds=${3:?seconds of the start}
-    backend=${4:?backend}
-    generations=${5:?generations}
-    shift 5
     mkdir -p "$out" /tmp/ab
     unpack_bundle
-    [ -f /tmp/ab/profile/checkpoint.bin ] || register /tmp/b/bin/morea /tmp/ab/profile "$seconds" cuda-texture || true
     MOREA_TIMELINE=/tmp/ab/timeline.txt MOREA_PROFILE="$out/main-thread.prof" MOREA_PROFILE_HZ=2000 \
       LD_PRELOAD="/tmp/b/lib/device-timeline.so /tmp/b/lib/main-thread-profiler.so" \
-      /tmp/b/bin/morea benchmark "${PROBLEM[@]}" --backends "$backend" --generations "$generations" --probe 0 \
-      --from-checkpoint /tmp/ab/profile/checkpoint.bin -o "$out/timeline.json" "$@" > "$out/timeline.log" 2>&1
-    summary "$out/timeline.json" "$backend" timeline
+      late_from_checkpoint "$out/timeline" "${@:3}"
+    summary "$out/timeline.json" "$4" timeline
     # The first seconds load the checkpoint and evaluate its population.
     python3 bench/tools/device-gaps.py /tmp/ab/timeline.txt --from-seconds "${MOREA_TIMELINE_SKIP:-1}" \
       --write-gaps "$out/gaps.txt" | tee "$out/gaps-summary.txt"
