@@ -39,8 +39,8 @@ struct SideView
 
   /** From shared memory: on an H100 the fold checks of late generations
    *  took 25.3-25.6 ms per generation against 26.3-26.6 ms with the scan
-   *  over global memory. (A scan without the early exit, loads all
-   *  independent, took 30.9 ms: elements have too many points.) */
+   *  over global memory. (The same scan without the early exit took
+   *  30.9 ms.) */
   __device__ int
   Local(std::uint32_t v) const
   {
