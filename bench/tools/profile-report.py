@@ -13,12 +13,14 @@ per function as the innermost frame (self) and anywhere on the stack
 name contains TEXT, with the functions called directly below it. With
 --during, only samples taken within the intervals a file lists (one
 "START END" line each, CLOCK_MONOTONIC nanoseconds, as device-gaps.py writes
-the device's idle gaps).
+the device's idle gaps); with --per-interval TEXT as well, interval by
+interval what the samples inside it did below the frame holding TEXT.
 """
 import argparse
 import bisect
 import collections
 import os
+import re
 import subprocess
 
 
@@ -57,6 +59,10 @@ def main():
                         help="with --lines: the line this many inlined calls inside that frame's own")
     parser.add_argument("--top", type=int, default=40)
     parser.add_argument("--during", help="a file of START END lines (ns): only samples taken within them")
+    parser.add_argument("--per-interval", metavar="TEXT",
+                        help="with --during: per interval, the paths its samples took below the outermost frame "
+                             "holding TEXT (e.g. RunGeneration)")
+    parser.add_argument("--depth-below", type=int, default=4, help="with --per-interval: frames per path")
     args = parser.parse_args()
 
     stacks, times, maps = [], [], []
@@ -114,7 +120,8 @@ def main():
             i = bisect.bisect_right(begins, t) - 1 if t is not None else -1
             return i >= 0 and t < spans[i][1]
 
-        stacks = [st for st, t in zip(stacks, times) if within(t)]
+        kept = [(st, t) for st, t in zip(stacks, times) if within(t)]
+        stacks, times = [k[0] for k in kept], [k[1] for k in kept]
     samples, addresses = [], []
     for stack in stacks:
         # Frames 0 and 1 are the signal handler and the kernel's return
@@ -123,6 +130,31 @@ def main():
         frame_addresses = stack[2:3] + [a - 1 for a in stack[3:]]
         samples.append([name(a) for a in frame_addresses])
         addresses.append(frame_addresses)
+    if args.per_interval:
+        # Interval by interval (--during), in time order: its length and the
+        # paths below the outermost frame holding TEXT that its samples took
+        # (function names without arguments or scopes), the commonest first.
+        def short(f):
+            lambda_in = re.search(r"_Function_handler<[^,]*, (.*)::\{lambda", f)
+            if lambda_in:  # a lambda run through std::function: where it was written
+                return short(lambda_in.group(1)) + ":lambda"
+            f = f.replace("(anonymous namespace)", "")
+            while re.search(r"<[^<>]*>", f):
+                f = re.sub(r"<[^<>]*>", "", f)
+            return re.sub(r"\(.*", "", f).split("::")[-1][:40]
+
+        per = collections.defaultdict(collections.Counter)
+        for st, t in zip(samples, times):
+            outer = [i for i, f in enumerate(st) if args.per_interval in f]
+            if outer:
+                o = max(outer)
+                path = "/".join(short(st[j]) for j in range(o - 1, max(o - 1 - args.depth_below, -1), -1))
+                per[bisect.bisect_right(begins, t) - 1][path or "(itself)"] += 1
+        for k in sorted(per)[: args.top]:
+            b, e = spans[k]
+            paths = "; ".join(f"{n} x {p}" for p, n in per[k].most_common(4))
+            print(f"{(b - spans[0][0]) * 1e-6:10.2f} ms: gap {(e - b) * 1e-6:6.2f} ms: {paths}")
+        return
     if args.under:
         kept = [i for i, s in enumerate(samples) if any(args.under in f for f in s)]
         samples = [samples[i] for i in kept]
