@@ -17,7 +17,6 @@
 #include <future>
 #include <filesystem>
 #include <iostream>
-#include <optional>
 #include <sstream>
 #include <unistd.h>
 

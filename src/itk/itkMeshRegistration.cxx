@@ -34,7 +34,8 @@ RegisterMeshes(const RegistrationProblem & problem, const ::morea::ParameterSet 
   };
   MeshRegistrationResult result;
   // The objective data (distance maps) need the model's frame only: they are
-  // made while the mesh is built (TetGen runs on one core).
+  // made while the mesh is built (TetGen runs on one core). Without a moving
+  // image there is no frame, and BuildMeshModel reports the missing images.
   std::future<::morea::ObjectiveData> objectiveData;
   if (problem.movingImage)
     objectiveData = std::async(std::launch::async, [&problem, &parameters] {
@@ -43,8 +44,7 @@ RegisterMeshes(const RegistrationProblem & problem, const ::morea::ParameterSet 
   result.model = BuildMeshModel(problem, parameters);
   const MeshModel & model = result.model;
   result.secondsMesh = lap();
-  const ::morea::ObjectiveData data =
-    objectiveData.valid() ? objectiveData.get() : BuildObjectiveData(problem, model, parameters);
+  const ::morea::ObjectiveData data = objectiveData.get();
   result.secondsObjectiveData = lap(); // what the mesh did not hide
   const ::morea::FoldConstraint constraint(model.topology, model.base.points,
                                                 parameters.GetReal("morea_fold_volume_fraction"));
