@@ -89,7 +89,8 @@ later = [g["seconds"] for g in run["per_generation"][1:]]
 print(f"{sys.argv[3]}: from generation {run['first_generation']}, {run['samples_per_second_kernel']:.4e} samples/s "
       f"in kernels, {run['seconds_per_generation']:.4f} s per generation "
       f"({sum(later) / max(1, len(later)):.4f} after the first), {run['seconds_in_kernels']:.3f} s in "
-      f"kernels, samples {run['samples']:.4g}, spared {run.get('bound_skipped_samples', 0):.4g}")
+      f"kernels ({run.get('seconds_in_setup_kernels', 0):.3f} set-up), samples {run['samples']:.4g}, "
+      f"spared {run.get('bound_skipped_samples', 0):.4g}")
 EOF
 }
 case "${1:-}" in

@@ -109,7 +109,8 @@ struct BackendStatistics
   std::uint64_t tetrahedra{ 0 };    ///< tetrahedra evaluated (both directions each)
   double        samples{ 0.0 };     ///< sample points drawn, both directions
   double        seconds{ 0.0 };     ///< wall time inside the calls
-  double        kernelSeconds{ 0.0 }; ///< device time of the kernels (CUDA only)
+  double        kernelSeconds{ 0.0 }; ///< device time of the sampling kernels, set-up included (CUDA only)
+  double        setUpKernelSeconds{ 0.0 }; ///< of kernelSeconds, the texture path's per-tetrahedron set-up
   double        foldSeconds{ 0.0 };   ///< of the calls' time, fold checks and repair (CUDA: device time they cover)
   // CUDA only, host time of the partial evaluations: packing and uploading a
   // batch, waiting for the device, handing the results back.

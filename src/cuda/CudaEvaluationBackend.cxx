@@ -184,6 +184,10 @@ struct BatchFlight
    *  the end of its values. */
   std::vector<std::unique_ptr<cuda::Event>> partEvents;
   std::vector<std::unique_ptr<cuda::Event>> copiedEvents; ///< per part: its values on the host
+  /** Per part: its candidates' sums on the host (and its fold outcome,
+   *  copied before them), ahead of its values. */
+  std::vector<std::unique_ptr<cuda::Event>> sumsCopiedEvents;
+  std::size_t                               partsWithValues{ 0 }; ///< parts whose copiedEvents were waited for
 
   std::size_t
   Parts() const
@@ -243,6 +247,8 @@ public:
       stream = std::make_unique<cuda::Stream>();
     m_MovedCopied = std::make_unique<cuda::Event>();
     m_FallbackStream = std::make_unique<cuda::Stream>(cuda::Stream::HighPriority{});
+    m_FallbackStart = std::make_unique<cuda::Event>();
+    m_FallbackEnd = std::make_unique<cuda::Event>();
     for (auto & flight : m_Flights)
     {
       flight = std::make_unique<BatchFlight>();
@@ -463,10 +469,11 @@ public:
   {
     const auto             start = std::chrono::steady_clock::now();
     const HostCandidates & h = m_HostCandidates[m_CurrentHost];
-    const BatchFlight &    f = *m_Flights[m_CurrentHost];
+    BatchFlight &          f = *m_Flights[m_CurrentHost];
     for (std::size_t i : which)
       if (i >= candidates.size() || i >= f.valuesWritten.size() || Skipped(candidates[i]))
         throw Error("evaluation backend: values asked for a candidate without them");
+    WaitForCandidateValues(f, which);
     m_Pool->ParallelFor(which.size(), [&](std::size_t w) {
       const std::size_t i = which[w];
       if (!f.valuesWritten[i])
@@ -488,6 +495,8 @@ public:
         throw Error("evaluation backend: only candidates the bound skipped can be sampled later");
       count += h.firstItem[i + 1] - h.firstItem[i];
     }
+    // Their sample counts and the values other than intensity and guidance.
+    WaitForCandidateValues(f, which);
     if (count == 0) // no tetrahedra: nothing to sample
     {
       for (std::size_t i : which)
@@ -523,8 +532,10 @@ public:
       Check(cudaMemcpyAsync(m_FallbackList.Data(), m_HostFallbackList.Data(), list.size() * sizeof(std::uint32_t),
                             cudaMemcpyHostToDevice, stream),
             "copying skipped candidates to the device");
+      Check(cudaEventRecord(m_FallbackStart->Get(), stream), "recording an event");
       cuda::LaunchSampleListedChunks(m_Constants, f.corners.Data(), m_FallbackList.Data(), entries,
                                      m_FallbackChunkSums.Data(), stream);
+      Check(cudaEventRecord(m_FallbackEnd->Get(), stream), "recording an event");
       Check(cudaMemcpyAsync(m_HostFallbackChunkSums.Data(), m_FallbackChunkSums.Data(), 2 * entries * sizeof(double),
                             cudaMemcpyDeviceToHost, stream),
             "copying values from the device");
@@ -560,13 +571,17 @@ public:
             "copying skipped candidates to the device");
       cuda::LaunchGatherItems(f.corners.Data(), f.tetrahedra.Data(), m_FallbackItems.Data(), count,
                               m_FallbackCorners.Data(), m_FallbackTetrahedra.Data(), stream);
+      Check(cudaEventRecord(m_FallbackStart->Get(), stream), "recording an event");
       cuda::LaunchEvaluateTetrahedra(m_Constants, m_FallbackCorners.Data(), m_FallbackTetrahedra.Data(), nullptr,
                                      count, m_FallbackItemValues.Data(), m_FallbackDirectionValues.Data(), stream);
+      Check(cudaEventRecord(m_FallbackEnd->Get(), stream), "recording an event");
       Check(cudaMemcpyAsync(m_HostFallbackDirectionValues.Data(), m_FallbackDirectionValues.Data(),
                             count * 2 * cuda::DirectionValues * sizeof(double), cudaMemcpyDeviceToHost, stream),
             "copying values from the device");
       Check(cudaStreamSynchronize(stream), "sampling skipped candidates");
     }
+    // Their samples count in `samples`, so their kernel's time counts too.
+    m_Statistics.kernelSeconds += ElapsedSeconds(*m_FallbackStart, *m_FallbackEnd);
     // Intensity and guidance as Unpack() adds them; the rest is the bound's
     // (the batch's values of the candidate); then the sum of them all.
     std::size_t at = 0;
@@ -1332,6 +1347,7 @@ private:
     f.candidateSums.Reserve(std::max<std::size_t>(1, n) * cuda::CandidateSumValues);
     f.hostCandidateSums.Reserve(std::max<std::size_t>(1, n) * cuda::CandidateSumValues);
     f.valuesWritten.assign(n, 0);
+    f.partsWithValues = 0;
     if (f.checks)
     {
       f.outcome.Reserve(2 * n);
@@ -1433,7 +1449,10 @@ private:
     while (f.partEvents.size() < BatchFlight::PartSteps * (p + 1))
       f.partEvents.push_back(std::make_unique<cuda::Event>());
     while (f.copiedEvents.size() < p + 1)
+    {
       f.copiedEvents.push_back(std::make_unique<cuda::Event>());
+      f.sumsCopiedEvents.push_back(std::make_unique<cuda::Event>());
+    }
     while (f.workspaces.size() < p + 1)
     {
       f.workspaces.push_back(std::make_unique<cuda::DeviceArray<unsigned char>>());
@@ -1502,19 +1521,22 @@ private:
     Check(cudaEventRecord(f.PartEvent(p, BatchFlight::ValuesEnd), stream), "recording an event");
     // The values go back on the copy stream, so that the next part's
     // kernels do not wait for the transfer (about 70 bytes per tetrahedron).
+    // The candidates' sums first: acceptance needs only them, and the
+    // values of the few it keeps (FetchValues) later.
     Check(cudaStreamWaitEvent(copies, f.PartEvent(p, BatchFlight::ValuesEnd), 0), "ordering a copy after its part");
-    Check(cudaMemcpyAsync(f.hostItemValues.Data() + begin * cuda::ItemValues, itemValues,
-                          count * cuda::ItemValues * sizeof(double), cudaMemcpyDeviceToHost, copies),
-          "copying values from the device");
-    Check(cudaMemcpyAsync(f.hostDirectionValues.Data() + begin * 2 * cuda::DirectionValues, directionValues,
-                          count * 2 * cuda::DirectionValues * sizeof(double), cudaMemcpyDeviceToHost, copies),
-          "copying values from the device");
     if (f.skipItems && endCandidate > firstCandidate)
       Check(cudaMemcpyAsync(f.hostCandidateSums.Data() + firstCandidate * cuda::CandidateSumValues,
                             f.candidateSums.Data() + firstCandidate * cuda::CandidateSumValues,
                             (endCandidate - firstCandidate) * cuda::CandidateSumValues * sizeof(double),
                             cudaMemcpyDeviceToHost, copies),
             "copying candidate sums from the device");
+    Check(cudaEventRecord(f.sumsCopiedEvents[p]->Get(), copies), "recording an event");
+    Check(cudaMemcpyAsync(f.hostItemValues.Data() + begin * cuda::ItemValues, itemValues,
+                          count * cuda::ItemValues * sizeof(double), cudaMemcpyDeviceToHost, copies),
+          "copying values from the device");
+    Check(cudaMemcpyAsync(f.hostDirectionValues.Data() + begin * 2 * cuda::DirectionValues, directionValues,
+                          count * 2 * cuda::DirectionValues * sizeof(double), cudaMemcpyDeviceToHost, copies),
+          "copying values from the device");
     Check(cudaEventRecord(f.copiedEvents[p]->Get(), copies), "recording an event");
   }
 
@@ -1544,7 +1566,9 @@ private:
       m_ChunksPerItem = std::max(m_ChunksPerItem, ChunkRoomMargin * static_cast<double>(chunks) / static_cast<double>(count));
     if (chunks <= f.chunkCapacity[p])
       return;
-    // Rare: once early in a run. The part's set-up is still in its workspace.
+    // Rare: once early in a run. The part's set-up is still in its workspace;
+    // its first values must have landed before they are copied again.
+    WaitForValues(f, p + 1);
     cudaStream_t stream = m_FallbackStream->Get();
     double *     directionValues = f.directionValues.Data() + begin * 2 * cuda::DirectionValues;
     f.chunkWorkspaces[p]->Reserve(cuda::TextureChunkWorkspaceBytes(chunks));
@@ -1567,6 +1591,31 @@ private:
       }
   }
 
+  /** Waits until the values of flight `f`'s first `parts` parts are on the
+   *  host (each part's follow its sums on the copy stream). */
+  void
+  WaitForValues(BatchFlight & f, std::size_t parts)
+  {
+    if (parts > f.partsWithValues)
+    {
+      WaitFor(f.copiedEvents[parts - 1]->Get(), "copying values from the device");
+      f.partsWithValues = parts;
+    }
+  }
+
+  /** WaitForValues for the parts holding candidates `which` of flight `f`. */
+  void
+  WaitForCandidateValues(BatchFlight & f, const std::vector<std::size_t> & which)
+  {
+    std::size_t parts = 0;
+    for (std::size_t i : which)
+    {
+      const auto bound = std::upper_bound(f.candidateBounds.begin(), f.candidateBounds.end(), i);
+      parts = std::max(parts, static_cast<std::size_t>(bound - f.candidateBounds.begin()));
+    }
+    WaitForValues(f, std::min(parts, f.Parts()));
+  }
+
   /** Hands the parts of flight `f` over in order as their values arrive:
    *  fold outcomes, values (or bounds), then ready(). */
   void
@@ -1580,7 +1629,7 @@ private:
     std::uint64_t         skippedItems = 0;
     for (std::size_t p = 0; p < parts; ++p)
     {
-      WaitFor(f.copiedEvents[p]->Get(), "copying values from the device");
+      WaitFor(f.sumsCopiedEvents[p]->Get(), "copying candidate sums from the device");
       CompleteOverflowingPart(f, p, first);
       // Read before ready() may start the next batch on the previous flight.
       if (p == 0 && f.items > 0 && m_PreviousFlight)
@@ -1596,8 +1645,10 @@ private:
       if (ready)
         ready(begin, end);
     }
-    // The batch's end, not the stream's: a started head may follow it.
+    // The batch's end, not the stream's: a started head may follow it. Its
+    // values too, so that no copy into the flight's buffers is left pending.
     WaitFor(f.end.Get(), "evaluating tetrahedra");
+    WaitForValues(f, parts);
     AddKernelSeconds(f);
     ++m_Statistics.batches;
     m_Statistics.tetrahedra += f.items - skippedItems;
@@ -1614,8 +1665,12 @@ private:
     for (std::size_t p = 0; p < f.Parts(); ++p)
     {
       if (UsesTexturePath())
-        m_Statistics.kernelSeconds +=
+      {
+        const double setUp =
           ElapsedSeconds(f.PartEvent(p, BatchFlight::SetUpStart), f.PartEvent(p, BatchFlight::SetUpEnd));
+        m_Statistics.kernelSeconds += setUp;
+        m_Statistics.setUpKernelSeconds += setUp;
+      }
       m_Statistics.kernelSeconds +=
         ElapsedSeconds(f.PartEvent(p, BatchFlight::SamplingStart), f.PartEvent(p, BatchFlight::SamplingEnd));
     }
@@ -1760,6 +1815,7 @@ private:
   // The sampling of the candidates a refusal screen skipped that the
   // optimiser needs after all.
   std::unique_ptr<cuda::Stream>                m_FallbackStream;
+  std::unique_ptr<cuda::Event>                 m_FallbackStart, m_FallbackEnd; ///< around its kernels
   cuda::PinnedArray<std::uint64_t>             m_HostFallbackItems;
   cuda::DeviceArray<std::uint64_t>             m_FallbackItems;
   cuda::DeviceArray<double> m_FallbackCorners, m_FallbackItemValues, m_FallbackDirectionValues;
