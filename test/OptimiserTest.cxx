@@ -188,6 +188,35 @@ TEST(MoRvGomea, SameSeedSameFrontWhateverTheThreadsOrEvaluationOrder)
   EXPECT_NE(a, d);
 }
 
+TEST(MoRvGomea, TheFirstGroupSplitInTwoBatchesChangesNoDecision)
+{
+  // The generation's first parallel group in two batches of half the
+  // population each: the same candidates, seeds and acceptance order, so
+  // the same front; one more batch per generation reaches the backend.
+  OptimiserTestProblem problem;
+  GomeaOptions         whole = problem.Options(23, 7);
+  whole.firstBatchSplit = 0;
+  GomeaOptions split = whole;
+  split.firstBatchSplit = 2;
+  auto       backend = CreateCpuEvaluationBackend(*problem.evaluator, 2);
+  const auto before = backend->Statistics().batches;
+  const auto a = RunToEnd(problem, *backend, whole);
+  const auto middle = backend->Statistics().batches;
+  const auto b = RunToEnd(problem, *backend, split);
+  ShufflingBackend shuffling(*problem.evaluator); // handed over in parts of random sizes
+  const auto       c = RunToEnd(problem, shuffling, split);
+  ASSERT_FALSE(a.empty());
+  EXPECT_EQ(a, b);
+  EXPECT_EQ(a, c);
+  EXPECT_EQ(backend->Statistics().batches - middle, middle - before + whole.generations);
+  // A population below the threshold goes whole.
+  GomeaOptions large = whole;
+  large.firstBatchSplit = whole.populationSize + 1;
+  const auto beforeLarge = backend->Statistics().batches;
+  EXPECT_EQ(a, RunToEnd(problem, *backend, large));
+  EXPECT_EQ(backend->Statistics().batches - beforeLarge, middle - before);
+}
+
 TEST(MoRvGomea, RefusalBoundsSpareSamplesAndChangeNoDecision)
 {
   // Candidates whose bound (RefusalBound.h) is refused go unsampled; the

@@ -60,6 +60,12 @@ struct GomeaOptions
    *  (RefusalBound.h). The result does not depend on it; whether it saves
    *  time depends on the backend (UsesRefusalBounds decides for `morea`). */
   bool boundRefusals{ true };
+  /** The generation's first parallel group goes to the backend in two
+   *  batches of half the population each when the population has at least
+   *  this many members (0: never), so that the device waits at the
+   *  generation's start only for the first half. The result does not depend
+   *  on it. */
+  std::size_t firstBatchSplit{ 64 };
 
   /** ea_* keys, morea_repair_method and seed. */
   static GomeaOptions

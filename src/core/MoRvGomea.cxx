@@ -187,6 +187,9 @@ struct MoRvGomea::CandidateBatch
   std::vector<CandidateFolds>   folds;
   std::vector<RefusalBound>     bounds; ///< per candidate, when GomeaOptions::boundRefusals
   bool                          partialsBuilt{ false };
+  /** Candidates [0, parentStateSet) have their parent's state
+   *  (SetParentState) while the batch before is handed over. */
+  std::size_t parentStateSet{ 0 };
   /** AcceptCandidates' per-candidate working storage (see there). */
   struct Judged
   {
@@ -804,6 +807,7 @@ MoRvGomea::BuildPartials(CandidateBatch & candidateBatch) const
     p.bound = m_Options.boundRefusals ? &candidateBatch.bounds[i] : nullptr;
   });
   candidateBatch.partialsBuilt = true;
+  candidateBatch.parentStateSet = 0;
 }
 
 void
@@ -870,8 +874,10 @@ MoRvGomea::ProcessCandidates(CandidateBatch & candidateBatch, GenerationRecord &
   std::vector<PartialCandidate> &    batch = candidateBatch.partials;
   const std::vector<CandidateFolds> & folds = candidateBatch.folds;
   // In parallel: the device waits for this (a batch holds tens of thousands).
+  // Those of solutions the batch before had finished with are set already.
   const auto parentStart = std::chrono::steady_clock::now();
-  SetParentState(candidateBatch, 0, candidates.size());
+  SetParentState(candidateBatch, candidateBatch.parentStateSet, candidates.size());
+  candidateBatch.parentStateSet = 0;
   record.phaseSeconds.parentState += SecondsSince(parentStart);
   // 2. Acceptance of each part of the batch as the backend hands it over
   //    (in order), while the device may still compute the next part.
@@ -882,24 +888,25 @@ MoRvGomea::ProcessCandidates(CandidateBatch & candidateBatch, GenerationRecord &
     accepted += AcceptCandidates(candidateBatch, batch, folds, begin, end, record);
     // The next batch's candidates of solutions this batch has finished with
     // (a prefix: both batches take the solutions in one order) are final:
-    // the backend may start on them while the rest is handed over (when it
-    // takes them: during one part of the batch).
-    if (next && next->partialsBuilt && end < candidates.size() && m_Backend.WantsNextPartials())
+    // their parents' state is set part by part (so that little of it is
+    // left for the hand-over in which the device waits), and the backend may
+    // start on them while the rest is handed over (when it takes them:
+    // during one part of the batch).
+    if (next && next->partialsBuilt && end < candidates.size())
     {
       std::vector<bool> pending(m_Population.size(), false);
       for (std::size_t i = end; i < candidates.size(); ++i)
         pending[candidates[i].solution] = true;
-      std::size_t head = 0;
+      std::size_t head = next->parentStateSet;
       while (head < next->candidates.size() && !pending[next->candidates[head].solution])
         ++head;
-      SetParentState(*next, 0, head);
-      if (m_Options.boundRefusals)
+      SetParentState(*next, next->parentStateSet, head);
+      next->parentStateSet = head;
+      if (m_Backend.WantsNextPartials())
       {
-        const RefusalScreen screen = ScreenFor(*next);
-        m_Backend.StartNextPartials(next->partials, head, &screen);
+        const RefusalScreen screen = m_Options.boundRefusals ? ScreenFor(*next) : RefusalScreen{};
+        m_Backend.StartNextPartials(next->partials, head, m_Options.boundRefusals ? &screen : nullptr);
       }
-      else
-        m_Backend.StartNextPartials(next->partials, head, nullptr);
     }
     acceptanceSeconds += SecondsSince(phaseStart);
   };
@@ -1305,21 +1312,42 @@ MoRvGomea::RunGeneration()
     }
   }
 
+  // A batch: one parallel group's candidates of members [firstMember,
+  // endMember). The generation's first group goes in two batches of half
+  // the members each: the device then waits at the generation's start only
+  // for the first half to be drawn and packed, and the second half, drawn
+  // meanwhile, starts as a whole behind it (no solution is in both). The
+  // order of the candidates, their seeds and the acceptance are those of
+  // one batch.
+  struct BatchSpan
+  {
+    std::size_t group, firstMember, endMember;
+  };
+  std::vector<BatchSpan> spans;
+  for (std::size_t i = 0; i < groupOrder.size(); ++i)
+  {
+    const std::size_t split =
+      i == 0 && m_Options.firstBatchSplit > 0 && members.size() >= m_Options.firstBatchSplit ? members.size() / 2 : 0;
+    if (split > 0)
+      spans.push_back({ groupOrder[i], 0, split });
+    spans.push_back({ groupOrder[i], split, members.size() });
+  }
+
   // Each batch's candidates are drawn while the backend evaluates the one
   // before (their samples depend on the cluster models only, not on what
   // that batch accepts); the seeds come in the same order as drawing each
   // batch just before its evaluation.
-  const auto drawBatch = [&](std::size_t g, CandidateBatch & next) {
+  const auto drawBatch = [&](const BatchSpan & span, CandidateBatch & next) {
     const auto               sampling = std::chrono::steady_clock::now();
     std::vector<Candidate> &           candidates = next.candidates;
-    const std::vector<std::uint32_t> & group = m_Parallel.groups[g];
+    const std::vector<std::uint32_t> & group = m_Parallel.groups[span.group];
     // Member by member, each one's elements in group order; the seeds drawn
     // in that order, the rest filled in on the pool.
-    candidates.resize(members.size() * group.size());
+    candidates.resize((span.endMember - span.firstMember) * group.size());
     for (Candidate & cand : candidates)
       cand.seed = random.NextU64();
-    m_Pool->ParallelFor(members.size(), [&](std::size_t m) {
-      const Member & member = members[m];
+    m_Pool->ParallelFor(span.endMember - span.firstMember, [&](std::size_t m) {
+      const Member & member = members[span.firstMember + m];
       for (std::size_t k = 0; k < group.size(); ++k)
       {
         Candidate &         cand = candidates[m * group.size() + k];
@@ -1336,15 +1364,15 @@ MoRvGomea::RunGeneration()
     SampleCandidates(next, clusters);
     record.phaseSeconds.sampling += SecondsSince(sampling);
   };
-  if (!groupOrder.empty())
-    drawBatch(groupOrder.front(), *m_Batch);
-  for (std::size_t i = 0; i < groupOrder.size(); ++i)
+  if (!spans.empty())
+    drawBatch(spans.front(), *m_Batch);
+  for (std::size_t i = 0; i < spans.size(); ++i)
   {
     CandidateBatch & batch = *m_Batch;
     EvaluationBackend::Meanwhile drawNext;
-    if (i + 1 < groupOrder.size())
+    if (i + 1 < spans.size())
       drawNext = [&, i] {
-        drawBatch(groupOrder[i + 1], *m_NextBatch);
+        drawBatch(spans[i + 1], *m_NextBatch);
         // The backend packs what it can of the next batch now: what this
         // batch's acceptance changes (parents, their keys) comes later.
         const auto staging = std::chrono::steady_clock::now();
@@ -1352,7 +1380,7 @@ MoRvGomea::RunGeneration()
         m_Backend.PrepareNextPartials(m_NextBatch->partials);
         record.phaseSeconds.evaluation += SecondsSince(staging);
       };
-    ProcessCandidates(batch, record, drawNext, i + 1 < groupOrder.size() ? m_NextBatch.get() : nullptr);
+    ProcessCandidates(batch, record, drawNext, i + 1 < spans.size() ? m_NextBatch.get() : nullptr);
     for (const Candidate & cand : batch.candidates)
       if (cand.accepted)
       {

@@ -77,7 +77,43 @@ ScatterParents(const double * __restrict__ staged, const std::uint32_t * __restr
   if (i < count * perParent)
     store[static_cast<std::size_t>(slots[i / perParent]) * perParent + i % perParent] = staged[i];
 }
+/** Thread d writes double d of the corners of whole solutions: item
+ *  s * tetrahedra + t is solution s's tetrahedron t (ItemCorners' layout),
+ *  so the stores are contiguous. */
+__global__ void
+GatherSolutionCorners(const double * __restrict__ solutions, std::size_t count, const std::uint32_t * __restrict__ mesh,
+                      std::uint32_t tetrahedraPerSolution, std::uint32_t points, double * corners,
+                      std::uint32_t * tetrahedra)
+{
+  const std::size_t d = static_cast<std::size_t>(blockIdx.x) * blockDim.x + threadIdx.x;
+  if (d >= count * tetrahedraPerSolution * ItemCorners)
+    return;
+  const std::size_t   item = d / ItemCorners;
+  const auto          within = static_cast<std::uint32_t>(d % ItemCorners);
+  const std::uint32_t side = within / 12, corner = within % 12 / 3, axis = within % 3;
+  const std::size_t   s = item / tetrahedraPerSolution;
+  const auto          t = static_cast<std::uint32_t>(item % tetrahedraPerSolution);
+  const std::uint32_t v = mesh[4 * static_cast<std::size_t>(t) + corner];
+  corners[d] = solutions[(2 * s + side) * 3 * static_cast<std::size_t>(points) + 3 * static_cast<std::size_t>(v) + axis];
+  if (within == 0)
+    tetrahedra[item] = t;
+}
 } // namespace
+
+void
+LaunchGatherSolutionCorners(const double * solutions, std::size_t count, const std::uint32_t * mesh,
+                            std::size_t tetrahedraPerSolution, std::size_t points, double * corners,
+                            std::uint32_t * tetrahedra, void * stream)
+{
+  const std::size_t doubles = count * tetrahedraPerSolution * ItemCorners;
+  if (doubles == 0)
+    return;
+  const unsigned blocks = static_cast<unsigned>((doubles + GatherThreads - 1) / GatherThreads);
+  GatherSolutionCorners<<<blocks, GatherThreads, 0, static_cast<cudaStream_t>(stream)>>>(
+    solutions, count, mesh, static_cast<std::uint32_t>(tetrahedraPerSolution), static_cast<std::uint32_t>(points),
+    corners, tetrahedra);
+  Check(cudaGetLastError(), "launching the solution corner kernel");
+}
 
 void
 LaunchGatherCandidateCorners(const CandidateBatch & batch, std::size_t items, const FoldedCandidateSkip & skip,

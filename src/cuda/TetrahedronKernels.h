@@ -162,6 +162,17 @@ void
 LaunchGatherCandidateCorners(const CandidateBatch & batch, std::size_t items, const FoldedCandidateSkip & skip,
                              double * corners, std::uint32_t * tetrahedra, std::uint8_t * itemSkip, void * stream);
 
+/** Writes the corners (ItemCorners each) and tetrahedron index of every
+ *  tetrahedron of `count` whole solutions, item s * tetrahedraPerSolution + t
+ *  for solution s's tetrahedron t, from `solutions` (per solution its
+ *  source points, then its target points, points x 3 doubles each) and
+ *  `mesh` (4 point indices per tetrahedron), as the host packs them.
+ *  Asynchronous on `stream`. */
+void
+LaunchGatherSolutionCorners(const double * solutions, std::size_t count, const std::uint32_t * mesh,
+                            std::size_t tetrahedraPerSolution, std::size_t points, double * corners,
+                            std::uint32_t * tetrahedra, void * stream);
+
 /** Per candidate of [batch.firstCandidate, batch.candidates): the sum over
  *  its items (in order, from 0, as the host adds them) of their values as
  *  the host unpacks them from `itemValues` and `directionValues`, to
