@@ -64,6 +64,7 @@ private:
   std::vector<std::uint64_t>                       m_KeyOfSlot;   ///< 0: nothing kept
   std::vector<std::uint64_t>                       m_BatchOfSlot; ///< the last batch that used it
   std::uint64_t                                    m_Batch{ 0 };
+  std::vector<std::uint64_t>                       m_Scratch; ///< AssignFirst's sorted keys
 };
 } // namespace morea
 

@@ -3,7 +3,6 @@
 #include "morea/Error.h"
 
 #include <algorithm>
-#include <unordered_set>
 
 namespace morea
 {
@@ -13,19 +12,21 @@ ParentSlots::AssignFirst(const std::vector<std::uint64_t> & keys, std::size_t to
   ++m_Batch;
   Assignment out;
   // Slots the batch needs: one per distinct nonzero key, one per key 0.
-  std::size_t needed = 0;
-  {
-    std::unordered_set<std::uint64_t> seen;
-    for (std::uint64_t k : keys)
-      if (k == 0 || seen.insert(k).second)
-        ++needed;
-  }
-  needed = std::max(needed, total);
+  // (Counted on a sorted copy: a hash set's node per key cost more, on the
+  // critical path of every batch's start.)
+  m_Scratch.assign(keys.begin(), keys.end());
+  std::sort(m_Scratch.begin(), m_Scratch.end());
+  const auto        zeros = static_cast<std::size_t>(std::upper_bound(m_Scratch.begin(), m_Scratch.end(), std::uint64_t{ 0 }) - m_Scratch.begin());
+  const std::size_t distinct =
+    static_cast<std::size_t>(std::unique(m_Scratch.begin() + static_cast<std::ptrdiff_t>(zeros), m_Scratch.end()) -
+                             (m_Scratch.begin() + static_cast<std::ptrdiff_t>(zeros)));
+  const std::size_t needed = std::max(zeros + distinct, total);
   if (needed > m_KeyOfSlot.size())
   {
     // A larger store starts empty (the device copy does not survive).
     const std::size_t capacity = std::max(needed, m_KeyOfSlot.size() + m_KeyOfSlot.size() / 4);
     m_SlotOfKey.clear();
+    m_SlotOfKey.reserve(capacity); // never rehashed while the store keeps its size
     m_KeyOfSlot.assign(capacity, 0);
     m_BatchOfSlot.assign(capacity, 0);
     out.grown = true;
