@@ -76,6 +76,15 @@ EvaluateAll(EvaluationBackend & backend, const std::vector<DualMesh> & populatio
   backend.EvaluateSolutions(solutions, outputs);
   return values;
 }
+/** A seeded run to its end: the archive's entries and the history. */
+std::pair<std::vector<ArchiveEntry>, std::vector<GenerationRecord>>
+RunToEnd(const OptimiserTestProblem & problem, EvaluationBackend & backend, const GomeaOptions & options)
+{
+  MoRvGomea optimiser(problem.base, problem.topology, problem.parallel, *problem.constraint, backend, options);
+  optimiser.Initialize(problem.InitialPopulation(options));
+  optimiser.Run();
+  return std::make_pair(optimiser.Archive().Entries(), optimiser.History());
+}
 } // namespace
 
 TEST(CudaEvaluationBackend, WholeSolutionsAgreeWithTheCpu)
@@ -392,12 +401,7 @@ TEST(CudaEvaluationBackend, RefusalBoundsChangeNoDecision)
   for (const CudaInterpolation interpolation : { CudaInterpolation::Exact, CudaInterpolation::Texture })
   {
     auto       backend = CreateCudaEvaluationBackend(*problem.evaluator, 2, interpolation);
-    const auto run = [&](const GomeaOptions & o) {
-      MoRvGomea optimiser(problem.base, problem.topology, problem.parallel, *problem.constraint, *backend, o);
-      optimiser.Initialize(problem.InitialPopulation(o));
-      optimiser.Run();
-      return std::make_pair(optimiser.Archive().Entries(), optimiser.History());
-    };
+    const auto run = [&](const GomeaOptions & o) { return RunToEnd(problem, *backend, o); };
     const auto all = run(sampleAll);
     const auto bounded = run(options);
     ASSERT_EQ(all.first.size(), bounded.first.size()) << backend->Name();
@@ -439,12 +443,7 @@ TEST(CudaEvaluationBackend, TheFirstGroupSplitInTwoBatchesChangesNoDecision)
   for (const CudaInterpolation interpolation : { CudaInterpolation::Exact, CudaInterpolation::Texture })
   {
     auto       backend = CreateCudaEvaluationBackend(*problem.evaluator, 2, interpolation);
-    const auto run = [&](const GomeaOptions & o) {
-      MoRvGomea optimiser(problem.base, problem.topology, problem.parallel, *problem.constraint, *backend, o);
-      optimiser.Initialize(problem.InitialPopulation(o));
-      optimiser.Run();
-      return std::make_pair(optimiser.Archive().Entries(), optimiser.History());
-    };
+    const auto run = [&](const GomeaOptions & o) { return RunToEnd(problem, *backend, o); };
     const auto started = backend->Statistics().startedCandidates;
     const auto a = run(whole);
     const auto middle = backend->Statistics().startedCandidates;

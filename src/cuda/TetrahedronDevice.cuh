@@ -197,6 +197,20 @@ WarpSum(double x)
   return x;
 }
 
+/** An item's values besides its samples' (ItemValues' layout: magnitude,
+ *  fold value, folded count) for tetrahedron t with corners `source` and
+ *  `target`; `elasticity` null: 1 for every tetrahedron. */
+inline __device__ void
+WriteItemValues(const double * referenceVolumes, double volumeFraction, const double * elasticity, std::uint32_t t,
+                const double source[12], const double target[12], double * out)
+{
+  double folded = 0.0;
+  double value = VolumeViolation(SignedVolume(source), referenceVolumes[t], volumeFraction, folded);
+  value += VolumeViolation(SignedVolume(target), referenceVolumes[t], volumeFraction, folded);
+  out[0] = TetrahedronMagnitude(source, target, elasticity ? elasticity[t] : 1.0);
+  out[1] = value;
+  out[2] = folded;
+}
 } // namespace morea::cuda::device
 
 #endif

@@ -239,14 +239,8 @@ EvaluateTetrahedraKernel(EvaluationConstants k, View moving, View fixed, const d
   out[2] = static_cast<double>(skip == ItemUnused ? 0u : full);
   if (direction == 0) // from = source, to = target
   {
-    const std::uint32_t t = tetrahedra[item];
-    double              folded = 0.0;
-    double              value = VolumeViolation(SignedVolume(from), k.referenceVolumes[t], k.volumeFraction, folded);
-    value += VolumeViolation(SignedVolume(to), k.referenceVolumes[t], k.volumeFraction, folded);
-    double * o = itemOut + item * ItemValues;
-    o[0] = TetrahedronMagnitude(from, to, k.elasticity ? k.elasticity[t] : 1.0);
-    o[1] = value;
-    o[2] = folded;
+    WriteItemValues(k.referenceVolumes, k.volumeFraction, k.elasticity, tetrahedra[item], from, to,
+                    itemOut + item * ItemValues);
   }
 }
 } // namespace

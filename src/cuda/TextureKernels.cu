@@ -258,14 +258,8 @@ PrepareTextureTasks(EvaluationConstants k, const double * __restrict__ corners,
     reinterpret_cast<uint2 *>(chunkCounts)[item] = make_uint2(chunksOf(forward.samples), chunksOf(backward.samples));
     itemIndex[item] = static_cast<std::uint32_t>(item);
 
-    const std::uint32_t t = tetrahedra[item];
-    double              folded = 0.0;
-    double              value = VolumeViolation(SignedVolume(source), k.referenceVolumes[t], k.volumeFraction, folded);
-    value += VolumeViolation(SignedVolume(target), k.referenceVolumes[t], k.volumeFraction, folded);
-    double * o = itemOut + item * ItemValues;
-    o[0] = TetrahedronMagnitude(source, target, k.elasticity ? k.elasticity[t] : 1.0);
-    o[1] = value;
-    o[2] = folded;
+    WriteItemValues(k.referenceVolumes, k.volumeFraction, k.elasticity, tetrahedra[item], source, target,
+                    itemOut + item * ItemValues);
   }
   __syncthreads();
   auto * out = reinterpret_cast<float4 *>(tasks + 2 * first);
