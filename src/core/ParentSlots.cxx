@@ -12,14 +12,13 @@ ParentSlots::AssignFirst(const std::vector<std::uint64_t> & keys, std::size_t to
   ++m_Batch;
   Assignment out;
   // Slots the batch needs: one per distinct nonzero key, one per key 0.
-  // (Counted on a sorted copy: a hash set's node per key cost more, on the
-  // critical path of every batch's start.)
+  // Counted on a sorted copy, without a hash set's allocation per key: this
+  // runs as every batch starts, while the device waits.
   m_Scratch.assign(keys.begin(), keys.end());
   std::sort(m_Scratch.begin(), m_Scratch.end());
-  const auto        zeros = static_cast<std::size_t>(std::upper_bound(m_Scratch.begin(), m_Scratch.end(), std::uint64_t{ 0 }) - m_Scratch.begin());
-  const std::size_t distinct =
-    static_cast<std::size_t>(std::unique(m_Scratch.begin() + static_cast<std::ptrdiff_t>(zeros), m_Scratch.end()) -
-                             (m_Scratch.begin() + static_cast<std::ptrdiff_t>(zeros)));
+  const auto nonzero = std::upper_bound(m_Scratch.begin(), m_Scratch.end(), std::uint64_t{ 0 });
+  const auto zeros = static_cast<std::size_t>(nonzero - m_Scratch.begin());
+  const auto distinct = static_cast<std::size_t>(std::unique(nonzero, m_Scratch.end()) - nonzero);
   const std::size_t needed = std::max(zeros + distinct, total);
   if (needed > m_KeyOfSlot.size())
   {
