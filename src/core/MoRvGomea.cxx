@@ -877,8 +877,16 @@ MoRvGomea::ProcessCandidates(CandidateBatch & candidateBatch, GenerationRecord &
   // Those of solutions the batch before had finished with are set already.
   const auto parentStart = std::chrono::steady_clock::now();
   SetParentState(candidateBatch, candidateBatch.parentStateSet, candidates.size());
-  candidateBatch.parentStateSet = 0;
   record.phaseSeconds.parentState += SecondsSince(parentStart);
+  // Per solution, the end of its last candidate in this batch (0: none): a
+  // solution is finished with once the parts handed over reach it.
+  std::vector<std::size_t> lastEnd;
+  if (next)
+  {
+    lastEnd.assign(m_Population.size(), 0);
+    for (std::size_t i = 0; i < candidates.size(); ++i)
+      lastEnd[candidates[i].solution] = i + 1;
+  }
   // 2. Acceptance of each part of the batch as the backend hands it over
   //    (in order), while the device may still compute the next part.
   std::size_t       accepted = 0;
@@ -894,11 +902,8 @@ MoRvGomea::ProcessCandidates(CandidateBatch & candidateBatch, GenerationRecord &
     // during one part of the batch).
     if (next && next->partialsBuilt && end < candidates.size())
     {
-      std::vector<bool> pending(m_Population.size(), false);
-      for (std::size_t i = end; i < candidates.size(); ++i)
-        pending[candidates[i].solution] = true;
       std::size_t head = next->parentStateSet;
-      while (head < next->candidates.size() && !pending[next->candidates[head].solution])
+      while (head < next->candidates.size() && lastEnd[next->candidates[head].solution] <= end)
         ++head;
       SetParentState(*next, next->parentStateSet, head);
       next->parentStateSet = head;
