@@ -456,6 +456,68 @@ TEST(ElitistArchive, JudgeAgreesWithAFullScan)
   }
 }
 
+TEST(ElitistArchive, JudgeNamesTheFirstRefusingEntry)
+{
+  // The scans test entries in blocks; the witness must still be the first
+  // entry, in entry order, that refuses: by dominance anywhere, else (with a
+  // grid) the first that crowds. Every archive size leaves another tail.
+  for (std::size_t capacity : { 100000, 60 })
+    for (std::size_t insertions : { 7, 300, 1500 })
+    {
+      const ElitistArchive archive = FilledArchive(capacity, insertions, 3 + capacity + insertions);
+      const auto           witnesses = archive.Witnesses();
+      const auto &         entries = archive.Entries();
+      morea::RandomGenerator random(insertions);
+      std::size_t            checked = 0;
+      for (int i = 0; i < 2000; ++i)
+      {
+        const Fitness f = RandomProbe(random, archive);
+        if (!f.feasible ||
+            !std::all_of(f.objectives.begin(), f.objectives.end(), [](double x) { return std::isfinite(x); }))
+          continue;
+        std::size_t dominance = entries.size(), crowding = entries.size();
+        for (std::size_t e = 0; e < entries.size() && dominance == entries.size(); ++e)
+        {
+          const ObjectiveVector & y = entries[e].fitness.objectives;
+          if (y == f.objectives || morea::Dominates(y, f.objectives))
+            dominance = e;
+          else if (crowding == entries.size() && archive.IsDiscretised() &&
+                   CellOf(y, archive.CellWidths()) == CellOf(f.objectives, archive.CellWidths()) &&
+                   !morea::Dominates(f.objectives, y))
+            crowding = e;
+        }
+        // A witness no entry has: no hint.
+        const morea::ArchiveVerdict verdict = archive.Judge(f, std::numeric_limits<std::uint64_t>::max());
+        if (dominance < entries.size())
+        {
+          ASSERT_EQ(verdict.kind, morea::ArchiveVerdict::Kind::Rejected) << i;
+          ASSERT_EQ(verdict.witness, witnesses[dominance]) << i;
+        }
+        else if (crowding < entries.size())
+        {
+          ASSERT_EQ(verdict.kind, morea::ArchiveVerdict::Kind::Crowded) << i;
+          ASSERT_EQ(verdict.witness, witnesses[crowding]) << i;
+        }
+        else
+          ASSERT_EQ(verdict.kind, morea::ArchiveVerdict::Kind::Accepted) << i;
+        ++checked;
+      }
+      EXPECT_GT(checked, 1500u);
+    }
+}
+
+TEST(ElitistArchive, RestoreRefusesNonFiniteObjectives)
+{
+  ElitistArchive original(100);
+  InsertRandomly(original, 50, 2, 0.0);
+  std::vector<morea::ArchiveEntry> entries = original.Entries();
+  ASSERT_FALSE(entries.empty());
+  entries.back().fitness.objectives[2] = std::numeric_limits<double>::quiet_NaN();
+  ElitistArchive restored(100);
+  EXPECT_THROW(restored.Restore(entries, false, ObjectiveVector{ 0.0, 0.0, 0.0 }), morea::Error);
+  EXPECT_EQ(restored.Size(), 0u); // nothing half-restored
+}
+
 TEST(ElitistArchive, RejectionsByDominanceOutlastInsertionsWithoutThinning)
 {
   // Capacity never reached: entries leave only for a newcomer that dominates

@@ -7,6 +7,7 @@
 #include "morea/ParetoFront.h"
 #include "morea/TetrahedralMesh.h"
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -158,11 +159,27 @@ private:
   };
   class EntryTest;
   struct Refuser;
+  struct Flagged;
 
   /** The first entry that `refuses`, trying entries `first` and `second`
    *  (hints; out of range for none) before all in order. */
   Refuser
   FindRefuser(const EntryTest & refuses, std::size_t first, std::size_t second) const;
+  /** The first entry from `begin` on that `refuses`, as FindRefuser's scan. */
+  Refuser
+  FirstRefuserFrom(const EntryTest & refuses, std::size_t begin) const;
+  /** The first entries from `begin` on that `refuses` rejects by dominance
+   *  and that it refuses for their cell alone (Size() where none), scanning
+   *  the columns block by block; with `stopAtRefuser`, only as far as the
+   *  first refuser of either kind. */
+  Flagged
+  ScanColumns(const EntryTest & refuses, std::size_t begin, bool stopAtRefuser) const;
+  /** The first entry from `begin` on that `f` dominates, or Size(). */
+  std::size_t
+  FirstDominatedBy(const ObjectiveVector & f, std::size_t begin) const;
+  /** Copies key `from` into the columns at `to` (to < Size()). */
+  void
+  SetColumns(std::size_t to, const Key & from);
   /** Records in `verdict` what a scan found. */
   void
   Settle(ArchiveVerdict & verdict, const Refuser & refuser) const;
@@ -186,6 +203,10 @@ private:
   std::size_t               m_Capacity;
   std::vector<ArchiveEntry> m_Entries;
   std::vector<Key>          m_Keys; ///< per entry, in entry order
+  /** The keys' objectives and cells column by column, in entry order (what
+   *  m_Keys holds): the scans test blocks of entries without branches, in
+   *  vector instructions. */
+  std::array<std::vector<double>, NumberOfObjectives> m_ObjectiveColumns, m_CellColumns;
   std::vector<bool>         m_Present; ///< per insertion number: whether that entry is here
   /** Meshes of removed entries, whose buffers a newcomer's copy reuses: most
    *  newcomers soon leave for a better one, and a copy into buffers of the

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <numeric>
 #include <string>
 
@@ -141,6 +142,21 @@ public:
     , m_Discretised(discretised)
     , m_Cell(discretised ? CellOf(f, widths) : Cell{})
   {}
+  const ObjectiveVector &
+  Objectives() const
+  {
+    return m_F;
+  }
+  bool
+  Discretised() const
+  {
+    return m_Discretised;
+  }
+  const Cell &
+  CandidateCell() const
+  {
+    return m_Cell;
+  }
   Refusal
   operator()(const Key & y) const
   {
@@ -163,6 +179,125 @@ struct ElitistArchive::Refuser
   std::size_t index; ///< Size() if none
   Refusal     refusal;
 };
+
+struct ElitistArchive::Flagged
+{
+  std::size_t dominance; ///< Size() if none
+  std::size_t cell;      ///< Size() if none
+};
+
+namespace
+{
+/** Entries per block of a scan: their flags are computed without branches,
+ *  in vector instructions where the compiler has them, then tested at once. */
+constexpr std::size_t ScanBlock = 16;
+
+/** A block's flags, bit k for its entry k. */
+struct BlockFlags
+{
+  std::uint32_t dominance{ 0 }; ///< the entry equals or dominates the candidate
+  std::uint32_t cell{ 0 };      ///< it shares the candidate's cell and the candidate does not dominate it
+};
+
+/** The index of the lowest set bit of `bits` (not 0). */
+std::size_t
+LowestBit(std::uint32_t bits)
+{
+  std::size_t k = 0;
+  while (!((bits >> k) & 1u))
+    ++k;
+  return k;
+}
+
+/** The columns an entry test reads. */
+struct ColumnView
+{
+  const double * objective[M];
+  const double * cell[M];
+};
+
+// The archive holds and judges finite objectives only (Accepts() turns
+// others away; Restore() checks). For finite values EqualsOrDominates(y, f)
+// is y <= f in every objective, and f dominates y exactly when f <= y in
+// every objective and y != f; an entry equal to f gets the dominance flag,
+// which takes precedence, so "f <= y in every objective" can stand for
+// "f dominates y" in the cell flag. The flags are EntryTest's answers.
+
+/** The flags of entries at .. at + count - 1 (count <= 32) for candidate
+ *  `f` in cell `fc` (cells compared with `Cells`). */
+template <bool Cells>
+BlockFlags
+FlagEntries(const ColumnView & v, std::size_t at, std::size_t count, const ObjectiveVector & f, const Cell & fc)
+{
+  BlockFlags flags;
+  for (std::size_t k = 0; k < count; ++k)
+  {
+    bool below = true, above = true, sameCell = true;
+    for (std::size_t j = 0; j < M; ++j)
+    {
+      const double y = v.objective[j][at + k];
+      below &= y <= f[j];
+      above &= f[j] <= y;
+      if constexpr (Cells)
+        sameCell &= v.cell[j][at + k] == fc[j];
+    }
+    flags.dominance |= static_cast<std::uint32_t>(below) << k;
+    if constexpr (Cells)
+      flags.cell |= static_cast<std::uint32_t>(sameCell & !above) << k;
+  }
+  return flags;
+}
+
+#if defined(__GNUC__)
+/** FlagEntries for a whole block, two entries per instruction (GCC and
+ *  Clang vector extensions: SSE2's packed compares on x86-64). Judging
+ *  200 000 probes against a discretised archive of 1729 entries took 1.06
+ *  us per probe on a 2-core development machine, against 1.81 us entry by
+ *  entry (blocks of 8: 1.29 us; of 32: as 16). */
+using Pair = double __attribute__((vector_size(2 * sizeof(double))));
+using PairMask = std::int64_t __attribute__((vector_size(2 * sizeof(double))));
+
+template <bool Cells>
+BlockFlags
+FlagBlock(const ColumnView & v, std::size_t at, const ObjectiveVector & f, const Cell & fc)
+{
+  BlockFlags flags;
+  for (std::size_t k = 0; k < ScanBlock; k += 2)
+  {
+    PairMask below = ~PairMask{}, above = ~PairMask{}, sameCell = ~PairMask{};
+    for (std::size_t j = 0; j < M; ++j)
+    {
+      Pair y;
+      std::memcpy(&y, v.objective[j] + at + k, sizeof y);
+      const Pair c = { f[j], f[j] };
+      below &= y <= c;
+      above &= c <= y;
+      if constexpr (Cells)
+      {
+        Pair yc;
+        std::memcpy(&yc, v.cell[j] + at + k, sizeof yc);
+        const Pair cc = { fc[j], fc[j] };
+        sameCell &= yc == cc;
+      }
+    }
+    flags.dominance |= static_cast<std::uint32_t>((below[0] & 1) | ((below[1] & 1) << 1)) << k;
+    if constexpr (Cells)
+    {
+      const PairMask crowds = sameCell & ~above;
+      flags.cell |= static_cast<std::uint32_t>((crowds[0] & 1) | ((crowds[1] & 1) << 1)) << k;
+    }
+  }
+  return flags;
+}
+#else
+template <bool Cells>
+BlockFlags
+FlagBlock(const ColumnView & v, std::size_t at, const ObjectiveVector & f, const Cell & fc)
+{
+  return FlagEntries<Cells>(v, at, ScanBlock, f, fc);
+}
+#endif
+} // namespace
 
 ElitistArchive::ElitistArchive(std::size_t capacity)
   : m_Capacity(capacity)
@@ -200,19 +335,14 @@ ElitistArchive::Judge(const Fitness & f, std::uint64_t witness) const
     return verdict;
   // One pass for both refusals: any entry that equals or dominates `f`
   // rejects it; else the hint, or the first entry, that crowds it does.
-  const EntryTest   refuses(f.objectives, m_Discretised, m_CellWidths);
-  std::size_t       crowding = m_Keys.size();
-  for (std::size_t i = 0; i < m_Keys.size(); ++i)
+  const EntryTest refuses(f.objectives, m_Discretised, m_CellWidths);
+  const Flagged   flagged = ScanColumns(refuses, 0, false);
+  if (flagged.dominance < m_Keys.size())
   {
-    const Refusal refusal = refuses(m_Keys[i]);
-    if (refusal == Refusal::Dominance)
-    {
-      verdict.witness = m_Keys[i].serial;
-      return verdict;
-    }
-    if (refusal == Refusal::Cell && crowding == m_Keys.size())
-      crowding = i;
+    verdict.witness = m_Keys[flagged.dominance].serial;
+    return verdict;
   }
+  std::size_t crowding = flagged.cell;
   if (hint < m_Keys.size() && crowding < m_Keys.size() && refuses(m_Keys[hint]) == Refusal::Cell)
     crowding = hint;
   Settle(verdict, Refuser{ crowding, crowding < m_Keys.size() ? Refusal::Cell : Refusal::None });
@@ -235,13 +365,7 @@ ElitistArchive::Accepts(const Fitness & f, ArchiveVerdict & verdict) const
     const EntryTest refuses(f.objectives, m_Discretised, m_CellWidths);
     const auto      newer = std::lower_bound(m_Keys.begin(), m_Keys.end(), verdict.insertions,
                                         [](const Key & k, std::uint64_t serial) { return k.serial < serial; });
-    Refuser         refuser{ m_Keys.size(), Refusal::None };
-    for (auto i = static_cast<std::size_t>(newer - m_Keys.begin()); i < m_Keys.size(); ++i)
-      if (const Refusal refusal = refuses(m_Keys[i]); refusal != Refusal::None)
-      {
-        refuser = Refuser{ i, refusal };
-        break;
-      }
+    const Refuser   refuser = FirstRefuserFrom(refuses, static_cast<std::size_t>(newer - m_Keys.begin()));
     verdict.insertions = m_Insertions;
     Settle(verdict, refuser);
     return verdict.kind == Kind::Accepted;
@@ -270,10 +394,71 @@ ElitistArchive::FindRefuser(const EntryTest & refuses, std::size_t first, std::s
     if (hint < m_Keys.size())
       if (const Refusal refusal = refuses(m_Keys[hint]); refusal != Refusal::None)
         return Refuser{ hint, refusal };
-  for (std::size_t i = 0; i < m_Keys.size(); ++i)
-    if (const Refusal refusal = refuses(m_Keys[i]); refusal != Refusal::None)
-      return Refuser{ i, refusal };
-  return Refuser{ m_Keys.size(), Refusal::None };
+  return FirstRefuserFrom(refuses, 0);
+}
+
+ElitistArchive::Refuser
+ElitistArchive::FirstRefuserFrom(const EntryTest & refuses, std::size_t begin) const
+{
+  const Flagged     flagged = ScanColumns(refuses, begin, true);
+  const std::size_t index = std::min(flagged.dominance, flagged.cell);
+  if (index == m_Keys.size())
+    return Refuser{ index, Refusal::None };
+  // An entry that both dominates and crowds refuses by dominance, as in EntryTest.
+  return Refuser{ index, index == flagged.dominance ? Refusal::Dominance : Refusal::Cell };
+}
+
+ElitistArchive::Flagged
+ElitistArchive::ScanColumns(const EntryTest & refuses, std::size_t begin, bool stopAtRefuser) const
+{
+  const std::size_t size = m_Keys.size();
+  Flagged           found{ size, size };
+  ColumnView        v{};
+  for (std::size_t j = 0; j < M; ++j)
+  {
+    v.objective[j] = m_ObjectiveColumns[j].data();
+    v.cell[j] = m_CellColumns[j].data();
+  }
+  const ObjectiveVector & f = refuses.Objectives();
+  const Cell &            fc = refuses.CandidateCell();
+  const bool              cells = refuses.Discretised();
+  for (std::size_t at = begin; at < size; at += ScanBlock)
+  {
+    const std::size_t count = std::min(ScanBlock, size - at);
+    const BlockFlags  flags = count < ScanBlock ? (cells ? FlagEntries<true>(v, at, count, f, fc)
+                                                         : FlagEntries<false>(v, at, count, f, fc))
+                                                : (cells ? FlagBlock<true>(v, at, f, fc) : FlagBlock<false>(v, at, f, fc));
+    if (flags.cell != 0 && found.cell == size)
+      found.cell = at + LowestBit(flags.cell);
+    if (flags.dominance != 0)
+    {
+      found.dominance = at + LowestBit(flags.dominance);
+      return found;
+    }
+    if (stopAtRefuser && found.cell < size)
+      return found;
+  }
+  return found;
+}
+
+std::size_t
+ElitistArchive::FirstDominatedBy(const ObjectiveVector & f, std::size_t begin) const
+{
+  // Dominates(f, y), its comparisons, entry by entry (only at insertions).
+  for (std::size_t i = begin; i < m_Keys.size(); ++i)
+    if (Dominates(f, m_Keys[i].objectives))
+      return i;
+  return m_Keys.size();
+}
+
+void
+ElitistArchive::SetColumns(std::size_t to, const Key & from)
+{
+  for (std::size_t j = 0; j < M; ++j)
+  {
+    m_ObjectiveColumns[j][to] = from.objectives[j];
+    m_CellColumns[j][to] = from.cell[j];
+  }
 }
 
 void
@@ -318,9 +503,7 @@ bool
 ElitistArchive::InsertAccepted(const Fitness & f, const DualMesh & solution, std::uint64_t id)
 {
   // Most newcomers dominate no entry, or a few: compact from the first.
-  std::size_t first = 0;
-  while (first < m_Keys.size() && !Dominates(f.objectives, m_Keys[first].objectives))
-    ++first;
+  const std::size_t first = FirstDominatedBy(f.objectives, 0);
   std::vector<bool> keep;
   if (first < m_Keys.size())
   {
@@ -368,6 +551,11 @@ ElitistArchive::Append(const Fitness & f, const DualMesh & solution, std::uint64
   entry.solution.target = solution.target;
   m_Entries.push_back(std::move(entry));
   m_Keys.push_back(Key{ f.objectives, m_Insertions, m_Discretised ? CellOf(f.objectives, m_CellWidths) : Cell{} });
+  for (std::size_t j = 0; j < M; ++j)
+  {
+    m_ObjectiveColumns[j].push_back(m_Keys.back().objectives[j]);
+    m_CellColumns[j].push_back(m_Keys.back().cell[j]);
+  }
   m_Present.push_back(true);
   ++m_Insertions;
 }
@@ -375,8 +563,11 @@ ElitistArchive::Append(const Fitness & f, const DualMesh & solution, std::uint64
 void
 ElitistArchive::RefreshCells()
 {
-  for (Key & k : m_Keys)
-    k.cell = m_Discretised ? CellOf(k.objectives, m_CellWidths) : Cell{};
+  for (std::size_t i = 0; i < m_Keys.size(); ++i)
+  {
+    m_Keys[i].cell = m_Discretised ? CellOf(m_Keys[i].objectives, m_CellWidths) : Cell{};
+    SetColumns(i, m_Keys[i]);
+  }
 }
 
 void
@@ -392,6 +583,7 @@ ElitistArchive::Compact(const std::vector<bool> & keep, std::size_t first)
       {
         std::swap(m_Entries[kept], m_Entries[i]); // the removed one moves back
         m_Keys[kept] = m_Keys[i];
+        SetColumns(kept, m_Keys[kept]);
       }
       ++kept;
     }
@@ -401,6 +593,11 @@ ElitistArchive::Compact(const std::vector<bool> & keep, std::size_t first)
     m_SpareMeshes.push_back(std::move(m_Entries[i].solution));
   m_Entries.resize(kept);
   m_Keys.resize(kept);
+  for (std::size_t j = 0; j < M; ++j)
+  {
+    m_ObjectiveColumns[j].resize(kept);
+    m_CellColumns[j].resize(kept);
+  }
 }
 
 void
@@ -439,6 +636,9 @@ ElitistArchive::Restore(std::vector<ArchiveEntry> entries, bool discretised, con
   if (entries.size() > m_Capacity)
     throw Error("elitist archive: cannot restore " + std::to_string(entries.size()) + " entries into a capacity of " +
                 std::to_string(m_Capacity));
+  for (const ArchiveEntry & e : entries)
+    if (!AllFinite(e.fitness.objectives))
+      throw Error("elitist archive: cannot restore an entry with non-finite objectives");
   for (const Key & k : m_Keys)
     m_Present[k.serial] = false;
   m_Entries = std::move(entries);
@@ -450,7 +650,12 @@ ElitistArchive::Restore(std::vector<ArchiveEntry> entries, bool discretised, con
     m_Keys.push_back(Key{ e.fitness.objectives, m_Insertions++, Cell{} });
     m_Present.push_back(true);
   }
-  RefreshCells();
+  for (std::size_t j = 0; j < M; ++j)
+  {
+    m_ObjectiveColumns[j].resize(m_Keys.size());
+    m_CellColumns[j].resize(m_Keys.size());
+  }
+  RefreshCells(); // the columns too
   ++m_Revision;
 }
 } // namespace morea
