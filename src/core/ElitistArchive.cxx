@@ -191,6 +191,7 @@ namespace
 /** Entries per block of a scan: their flags are computed without branches,
  *  in vector instructions where the compiler has them, then tested at once. */
 constexpr std::size_t ScanBlock = 16;
+static_assert(ScanBlock % 2 == 0 && ScanBlock <= 32, "pairs of entries, a bit each in 32");
 
 /** A block's flags, bit k for its entry k. */
 struct BlockFlags
@@ -248,6 +249,26 @@ FlagEntries(const ColumnView & v, std::size_t at, std::size_t count, const Objec
   return flags;
 }
 
+/** Bit k set where `f` dominates entry at + k (k < count <= 32): for
+ *  finite values, f <= y in every objective and f != y. */
+std::uint32_t
+DominatedEntries(const ColumnView & v, std::size_t at, std::size_t count, const ObjectiveVector & f)
+{
+  std::uint32_t bits = 0;
+  for (std::size_t k = 0; k < count; ++k)
+  {
+    bool above = true, equal = true;
+    for (std::size_t j = 0; j < M; ++j)
+    {
+      const double y = v.objective[j][at + k];
+      above &= f[j] <= y;
+      equal &= f[j] == y;
+    }
+    bits |= static_cast<std::uint32_t>(above & !equal) << k;
+  }
+  return bits;
+}
+
 #if defined(__GNUC__)
 /** FlagEntries for a whole block, two entries per instruction (GCC and
  *  Clang vector extensions: SSE2's packed compares on x86-64). Judging
@@ -289,12 +310,40 @@ FlagBlock(const ColumnView & v, std::size_t at, const ObjectiveVector & f, const
   }
   return flags;
 }
+
+/** DominatedEntries for a whole block, two entries per instruction. */
+std::uint32_t
+DominatedBlock(const ColumnView & v, std::size_t at, const ObjectiveVector & f)
+{
+  std::uint32_t bits = 0;
+  for (std::size_t k = 0; k < ScanBlock; k += 2)
+  {
+    PairMask above = ~PairMask{}, equal = ~PairMask{};
+    for (std::size_t j = 0; j < M; ++j)
+    {
+      Pair y;
+      std::memcpy(&y, v.objective[j] + at + k, sizeof y);
+      const Pair c = { f[j], f[j] };
+      above &= c <= y;
+      equal &= c == y;
+    }
+    const PairMask dominated = above & ~equal;
+    bits |= static_cast<std::uint32_t>((dominated[0] & 1) | ((dominated[1] & 1) << 1)) << k;
+  }
+  return bits;
+}
 #else
 template <bool Cells>
 BlockFlags
 FlagBlock(const ColumnView & v, std::size_t at, const ObjectiveVector & f, const Cell & fc)
 {
   return FlagEntries<Cells>(v, at, ScanBlock, f, fc);
+}
+
+std::uint32_t
+DominatedBlock(const ColumnView & v, std::size_t at, const ObjectiveVector & f)
+{
+  return DominatedEntries(v, at, ScanBlock, f);
 }
 #endif
 } // namespace
@@ -444,11 +493,18 @@ ElitistArchive::ScanColumns(const EntryTest & refuses, std::size_t begin, bool s
 std::size_t
 ElitistArchive::FirstDominatedBy(const ObjectiveVector & f, std::size_t begin) const
 {
-  // Dominates(f, y), its comparisons, entry by entry (only at insertions).
-  for (std::size_t i = begin; i < m_Keys.size(); ++i)
-    if (Dominates(f, m_Keys[i].objectives))
-      return i;
-  return m_Keys.size();
+  const std::size_t size = m_Keys.size();
+  ColumnView        v{};
+  for (std::size_t j = 0; j < M; ++j)
+    v.objective[j] = m_ObjectiveColumns[j].data();
+  for (std::size_t at = begin; at < size; at += ScanBlock)
+  {
+    const std::size_t   count = std::min(ScanBlock, size - at);
+    const std::uint32_t dominated = count < ScanBlock ? DominatedEntries(v, at, count, f) : DominatedBlock(v, at, f);
+    if (dominated != 0)
+      return at + LowestBit(dominated);
+  }
+  return size;
 }
 
 void
