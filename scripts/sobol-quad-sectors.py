@@ -41,17 +41,10 @@ def sectors_per_group(rows, p, group, shape):
     return total / groups
 
 
-def lane_rows(basis, bits):
-    """The cosets of span(basis) in lane order (lane bit b: basis vector b)."""
-    members = np.array([np.bitwise_xor.reduce([basis[b] for b in range(5) if (lane >> b) & 1] or [0])
-                        for lane in range(32)])
-    seen, rows = np.zeros(1 << bits, bool), []
-    for k in range(1 << bits):
-        if not seen[k]:
-            row = k ^ members
-            seen[row] = True
-            rows.append(row)
-    return rows
+def lane_rows_of(basis, bits):
+    """The cosets of span(basis) in lane order: span() lists element i as the
+    XOR of the basis vectors of i's set bits, lane i's offset."""
+    return cosets.block_cosets(basis, bits)
 
 
 def with_quad(pair, basis):
@@ -75,10 +68,10 @@ def main():
                   for t in range(2)]
         pairs = {frozenset((a, b, a ^ b)) for a, b in itertools.combinations(cosets.span(basis)[1:], 2)}
         for shape in [(8, 1), (4, 2)]:
-            now = np.mean([sectors_per_group(lane_rows(basis, bits), p, 4, shape) for p in blocks])
-            best = min((sectors_per_group(lane_rows(with_quad(sorted(q)[:2], basis), bits), blocks[0], 4, shape),
+            now = np.mean([sectors_per_group(lane_rows_of(basis, bits), p, 4, shape) for p in blocks])
+            best = min((sectors_per_group(lane_rows_of(with_quad(sorted(q)[:2], basis), bits), blocks[0], 4, shape),
                         sorted(q)[:2]) for q in pairs)
-            best_both = np.mean([sectors_per_group(lane_rows(with_quad(best[1], basis), bits), p, 4, shape)
+            best_both = np.mean([sectors_per_group(lane_rows_of(with_quad(best[1], basis), bits), p, 4, shape)
                                  for p in blocks])
             print(f"2^{bits}, sectors of {shape[0]} x {shape[1]} texels: {now:.2f} per quad now, "
                   f"{best_both:.2f} with quads spanned by {best[1]}", flush=True)
