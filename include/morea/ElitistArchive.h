@@ -146,17 +146,6 @@ public:
   Restore(std::vector<ArchiveEntry> entries, bool discretised, const ObjectiveVector & cellWidths);
 
 private:
-  /** What the scans read of an entry, kept apart from the payloads so a scan
-   *  runs through a small array. */
-  struct Key
-  {
-    ObjectiveVector objectives;
-    /** Entries inserted before it: ascending in entry order, so the entries
-     *  newer than a verdict are a suffix. */
-    std::uint64_t serial;
-    /** Its grid cell (when discretised), kept so a scan need not divide. */
-    ObjectiveVector cell;
-  };
   class EntryTest;
   struct Refuser;
   struct Flagged;
@@ -177,9 +166,14 @@ private:
   /** The first entry from `begin` on that `f` dominates, or Size(). */
   std::size_t
   FirstDominatedBy(const ObjectiveVector & f, std::size_t begin) const;
-  /** Copies key `from` into the columns at `to` (to < Size()). */
+  /** Entry `i`'s objectives and grid cell, from the columns. */
+  ObjectiveVector
+  ObjectivesAt(std::size_t i) const;
+  ObjectiveVector
+  CellAt(std::size_t i) const;
+  /** Appends an entry's objectives and cell to the columns. */
   void
-  SetColumns(std::size_t to, const Key & from);
+  AppendColumns(const ObjectiveVector & objectives, const ObjectiveVector & cell);
   /** Records in `verdict` what a scan found. */
   void
   Settle(ArchiveVerdict & verdict, const Refuser & refuser) const;
@@ -202,10 +196,13 @@ private:
 
   std::size_t               m_Capacity;
   std::vector<ArchiveEntry> m_Entries;
-  std::vector<Key>          m_Keys; ///< per entry, in entry order
-  /** The keys' objectives and cells column by column, in entry order (what
-   *  m_Keys holds): the scans test blocks of entries without branches, in
-   *  vector instructions. */
+  /** Per entry, in entry order, the entries inserted before it: ascending,
+   *  so the entries newer than a verdict are a suffix. */
+  std::vector<std::uint64_t> m_Serials;
+  /** What the scans read of the entries, column by column in entry order and
+   *  apart from the payloads: their objectives and grid cells (when
+   *  discretised; kept so a scan need not divide). A scan tests blocks of
+   *  entries without branches, in vector instructions. */
   std::array<std::vector<double>, NumberOfObjectives> m_ObjectiveColumns, m_CellColumns;
   std::vector<bool>         m_Present; ///< per insertion number: whether that entry is here
   /** Meshes of removed entries, whose buffers a newcomer's copy reuses: most

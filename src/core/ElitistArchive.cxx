@@ -157,13 +157,14 @@ public:
   {
     return m_Cell;
   }
+  /** For an entry of objectives `y` in cell `cell` (CellOf(y, widths): the
+   *  grid is the archive's). */
   Refusal
-  operator()(const Key & y) const
+  operator()(const ObjectiveVector & y, const Cell & cell) const
   {
-    if (EqualsOrDominates(y.objectives, m_F))
+    if (EqualsOrDominates(y, m_F))
       return Refusal::Dominance;
-    // y.cell is CellOf(y.objectives, m_Widths): the grid is the archive's.
-    if (m_Discretised && y.cell == m_Cell && !Dominates(m_F, y.objectives))
+    if (m_Discretised && cell == m_Cell && !Dominates(m_F, y))
       return Refusal::Cell;
     return Refusal::None;
   }
@@ -216,6 +217,18 @@ struct ColumnView
   const double * objective[M];
   const double * cell[M];
 };
+
+ColumnView
+ViewOf(const std::array<std::vector<double>, M> & objectives, const std::array<std::vector<double>, M> & cells)
+{
+  ColumnView v{};
+  for (std::size_t j = 0; j < M; ++j)
+  {
+    v.objective[j] = objectives[j].data();
+    v.cell[j] = cells[j].data();
+  }
+  return v;
+}
 
 // The archive holds and judges finite objectives only (Accepts() turns
 // others away; Restore() checks). For finite values EqualsOrDominates(y, f)
@@ -380,21 +393,21 @@ ElitistArchive::Judge(const Fitness & f, std::uint64_t witness) const
     return verdict;
   // Dominance first: the refusal that lasts.
   const std::size_t hint = IndexOf(witness);
-  if (hint < m_Keys.size() && EqualsOrDominates(m_Keys[hint].objectives, f.objectives))
+  if (hint < m_Serials.size() && EqualsOrDominates(ObjectivesAt(hint), f.objectives))
     return verdict;
   // One pass for both refusals: any entry that equals or dominates `f`
   // rejects it; else the hint, or the first entry, that crowds it does.
   const EntryTest refuses(f.objectives, m_Discretised, m_CellWidths);
   const Flagged   flagged = ScanColumns(refuses, 0, false);
-  if (flagged.dominance < m_Keys.size())
+  if (flagged.dominance < m_Serials.size())
   {
-    verdict.witness = m_Keys[flagged.dominance].serial;
+    verdict.witness = m_Serials[flagged.dominance];
     return verdict;
   }
   std::size_t crowding = flagged.cell;
-  if (hint < m_Keys.size() && crowding < m_Keys.size() && refuses(m_Keys[hint]) == Refusal::Cell)
+  if (hint < m_Serials.size() && crowding < m_Serials.size() && refuses(ObjectivesAt(hint), CellAt(hint)) == Refusal::Cell)
     crowding = hint;
-  Settle(verdict, Refuser{ crowding, crowding < m_Keys.size() ? Refusal::Cell : Refusal::None });
+  Settle(verdict, Refuser{ crowding, crowding < m_Serials.size() ? Refusal::Cell : Refusal::None });
   return verdict;
 }
 
@@ -412,9 +425,8 @@ ElitistArchive::Accepts(const Fitness & f, ArchiveVerdict & verdict) const
     // No entry of the verdict's time refused `f`, and with the grid unchanged
     // none of those still here does now: only the newer ones can.
     const EntryTest refuses(f.objectives, m_Discretised, m_CellWidths);
-    const auto      newer = std::lower_bound(m_Keys.begin(), m_Keys.end(), verdict.insertions,
-                                        [](const Key & k, std::uint64_t serial) { return k.serial < serial; });
-    const Refuser   refuser = FirstRefuserFrom(refuses, static_cast<std::size_t>(newer - m_Keys.begin()));
+    const auto      newer = std::lower_bound(m_Serials.begin(), m_Serials.end(), verdict.insertions);
+    const Refuser   refuser = FirstRefuserFrom(refuses, static_cast<std::size_t>(newer - m_Serials.begin()));
     verdict.insertions = m_Insertions;
     Settle(verdict, refuser);
     return verdict.kind == Kind::Accepted;
@@ -440,8 +452,8 @@ ElitistArchive::Refuser
 ElitistArchive::FindRefuser(const EntryTest & refuses, std::size_t first, std::size_t second) const
 {
   for (std::size_t hint : { first, second })
-    if (hint < m_Keys.size())
-      if (const Refusal refusal = refuses(m_Keys[hint]); refusal != Refusal::None)
+    if (hint < m_Serials.size())
+      if (const Refusal refusal = refuses(ObjectivesAt(hint), CellAt(hint)); refusal != Refusal::None)
         return Refuser{ hint, refusal };
   return FirstRefuserFrom(refuses, 0);
 }
@@ -451,7 +463,7 @@ ElitistArchive::FirstRefuserFrom(const EntryTest & refuses, std::size_t begin) c
 {
   const Flagged     flagged = ScanColumns(refuses, begin, true);
   const std::size_t index = std::min(flagged.dominance, flagged.cell);
-  if (index == m_Keys.size())
+  if (index == m_Serials.size())
     return Refuser{ index, Refusal::None };
   // An entry that both dominates and crowds refuses by dominance, as in EntryTest.
   return Refuser{ index, index == flagged.dominance ? Refusal::Dominance : Refusal::Cell };
@@ -460,14 +472,9 @@ ElitistArchive::FirstRefuserFrom(const EntryTest & refuses, std::size_t begin) c
 ElitistArchive::Flagged
 ElitistArchive::ScanColumns(const EntryTest & refuses, std::size_t begin, bool stopAtRefuser) const
 {
-  const std::size_t size = m_Keys.size();
+  const std::size_t size = m_Serials.size();
   Flagged           found{ size, size };
-  ColumnView        v{};
-  for (std::size_t j = 0; j < M; ++j)
-  {
-    v.objective[j] = m_ObjectiveColumns[j].data();
-    v.cell[j] = m_CellColumns[j].data();
-  }
+  const ColumnView  v = ViewOf(m_ObjectiveColumns, m_CellColumns);
   const ObjectiveVector & f = refuses.Objectives();
   const Cell &            fc = refuses.CandidateCell();
   const bool              cells = refuses.Discretised();
@@ -493,10 +500,8 @@ ElitistArchive::ScanColumns(const EntryTest & refuses, std::size_t begin, bool s
 std::size_t
 ElitistArchive::FirstDominatedBy(const ObjectiveVector & f, std::size_t begin) const
 {
-  const std::size_t size = m_Keys.size();
-  ColumnView        v{};
-  for (std::size_t j = 0; j < M; ++j)
-    v.objective[j] = m_ObjectiveColumns[j].data();
+  const std::size_t size = m_Serials.size();
+  const ColumnView  v = ViewOf(m_ObjectiveColumns, m_CellColumns);
   for (std::size_t at = begin; at < size; at += ScanBlock)
   {
     const std::size_t   count = std::min(ScanBlock, size - at);
@@ -507,13 +512,31 @@ ElitistArchive::FirstDominatedBy(const ObjectiveVector & f, std::size_t begin) c
   return size;
 }
 
+ObjectiveVector
+ElitistArchive::ObjectivesAt(std::size_t i) const
+{
+  ObjectiveVector y;
+  for (std::size_t j = 0; j < M; ++j)
+    y[j] = m_ObjectiveColumns[j][i];
+  return y;
+}
+
+ObjectiveVector
+ElitistArchive::CellAt(std::size_t i) const
+{
+  ObjectiveVector cell;
+  for (std::size_t j = 0; j < M; ++j)
+    cell[j] = m_CellColumns[j][i];
+  return cell;
+}
+
 void
-ElitistArchive::SetColumns(std::size_t to, const Key & from)
+ElitistArchive::AppendColumns(const ObjectiveVector & objectives, const ObjectiveVector & cell)
 {
   for (std::size_t j = 0; j < M; ++j)
   {
-    m_ObjectiveColumns[j][to] = from.objectives[j];
-    m_CellColumns[j][to] = from.cell[j];
+    m_ObjectiveColumns[j].push_back(objectives[j]);
+    m_CellColumns[j].push_back(cell[j]);
   }
 }
 
@@ -532,15 +555,14 @@ ElitistArchive::Settle(ArchiveVerdict & verdict, const Refuser & refuser) const
       verdict.kind = ArchiveVerdict::Kind::Crowded;
       break;
   }
-  verdict.witness = m_Keys[refuser.index].serial;
+  verdict.witness = m_Serials[refuser.index];
 }
 
 std::size_t
 ElitistArchive::IndexOf(std::uint64_t serial) const
 {
-  const auto it = std::lower_bound(m_Keys.begin(), m_Keys.end(), serial,
-                                   [](const Key & k, std::uint64_t wanted) { return k.serial < wanted; });
-  return it != m_Keys.end() && it->serial == serial ? static_cast<std::size_t>(it - m_Keys.begin()) : m_Keys.size();
+  const auto it = std::lower_bound(m_Serials.begin(), m_Serials.end(), serial);
+  return it != m_Serials.end() && *it == serial ? static_cast<std::size_t>(it - m_Serials.begin()) : m_Serials.size();
 }
 
 bool
@@ -561,11 +583,11 @@ ElitistArchive::InsertAccepted(const Fitness & f, const DualMesh & solution, std
   // Most newcomers dominate no entry, or a few: compact from the first.
   const std::size_t first = FirstDominatedBy(f.objectives, 0);
   std::vector<bool> keep;
-  if (first < m_Keys.size())
+  if (first < m_Serials.size())
   {
-    keep.assign(m_Keys.size(), true);
-    for (std::size_t i = first; i < m_Keys.size(); ++i)
-      keep[i] = !Dominates(f.objectives, m_Keys[i].objectives);
+    keep.assign(m_Serials.size(), true);
+    for (std::size_t i = first; i < m_Serials.size(); ++i)
+      keep[i] = !Dominates(f.objectives, ObjectivesAt(i));
     Compact(keep, first);
   }
   Append(f, solution, id);
@@ -606,12 +628,8 @@ ElitistArchive::Append(const Fitness & f, const DualMesh & solution, std::uint64
   entry.solution.source = solution.source; // into the spare's buffers
   entry.solution.target = solution.target;
   m_Entries.push_back(std::move(entry));
-  m_Keys.push_back(Key{ f.objectives, m_Insertions, m_Discretised ? CellOf(f.objectives, m_CellWidths) : Cell{} });
-  for (std::size_t j = 0; j < M; ++j)
-  {
-    m_ObjectiveColumns[j].push_back(m_Keys.back().objectives[j]);
-    m_CellColumns[j].push_back(m_Keys.back().cell[j]);
-  }
+  m_Serials.push_back(m_Insertions);
+  AppendColumns(f.objectives, m_Discretised ? CellOf(f.objectives, m_CellWidths) : Cell{});
   m_Present.push_back(true);
   ++m_Insertions;
 }
@@ -619,10 +637,11 @@ ElitistArchive::Append(const Fitness & f, const DualMesh & solution, std::uint64
 void
 ElitistArchive::RefreshCells()
 {
-  for (std::size_t i = 0; i < m_Keys.size(); ++i)
+  for (std::size_t i = 0; i < m_Serials.size(); ++i)
   {
-    m_Keys[i].cell = m_Discretised ? CellOf(m_Keys[i].objectives, m_CellWidths) : Cell{};
-    SetColumns(i, m_Keys[i]);
+    const Cell cell = m_Discretised ? CellOf(ObjectivesAt(i), m_CellWidths) : Cell{};
+    for (std::size_t j = 0; j < M; ++j)
+      m_CellColumns[j][i] = cell[j];
   }
 }
 
@@ -638,17 +657,21 @@ ElitistArchive::Compact(const std::vector<bool> & keep, std::size_t first)
       if (kept != i)
       {
         std::swap(m_Entries[kept], m_Entries[i]); // the removed one moves back
-        m_Keys[kept] = m_Keys[i];
-        SetColumns(kept, m_Keys[kept]);
+        m_Serials[kept] = m_Serials[i];
+        for (std::size_t j = 0; j < M; ++j)
+        {
+          m_ObjectiveColumns[j][kept] = m_ObjectiveColumns[j][i];
+          m_CellColumns[j][kept] = m_CellColumns[j][i];
+        }
       }
       ++kept;
     }
     else
-      m_Present[m_Keys[i].serial] = false;
+      m_Present[m_Serials[i]] = false;
   for (std::size_t i = kept; i < m_Entries.size() && m_SpareMeshes.size() < MaximumSpares; ++i)
     m_SpareMeshes.push_back(std::move(m_Entries[i].solution));
   m_Entries.resize(kept);
-  m_Keys.resize(kept);
+  m_Serials.resize(kept);
   for (std::size_t j = 0; j < M; ++j)
   {
     m_ObjectiveColumns[j].resize(kept);
@@ -679,11 +702,7 @@ ElitistArchive::Objectives() const
 std::vector<std::uint64_t>
 ElitistArchive::Witnesses() const
 {
-  std::vector<std::uint64_t> serials;
-  serials.reserve(m_Keys.size());
-  for (const Key & k : m_Keys)
-    serials.push_back(k.serial);
-  return serials;
+  return m_Serials;
 }
 
 void
@@ -695,23 +714,24 @@ ElitistArchive::Restore(std::vector<ArchiveEntry> entries, bool discretised, con
   for (const ArchiveEntry & e : entries)
     if (!AllFinite(e.fitness.objectives))
       throw Error("elitist archive: cannot restore an entry with non-finite objectives");
-  for (const Key & k : m_Keys)
-    m_Present[k.serial] = false;
+  for (std::uint64_t serial : m_Serials)
+    m_Present[serial] = false;
   m_Entries = std::move(entries);
-  m_Keys.clear();
+  m_Serials.clear();
+  for (std::size_t j = 0; j < M; ++j)
+  {
+    m_ObjectiveColumns[j].clear();
+    m_CellColumns[j].clear();
+  }
   m_Discretised = discretised;
   m_CellWidths = cellWidths;
   for (const ArchiveEntry & e : m_Entries)
   {
-    m_Keys.push_back(Key{ e.fitness.objectives, m_Insertions++, Cell{} });
+    m_Serials.push_back(m_Insertions++);
+    AppendColumns(e.fitness.objectives, Cell{});
     m_Present.push_back(true);
   }
-  for (std::size_t j = 0; j < M; ++j)
-  {
-    m_ObjectiveColumns[j].resize(m_Keys.size());
-    m_CellColumns[j].resize(m_Keys.size());
-  }
-  RefreshCells(); // the columns too
+  RefreshCells();
   ++m_Revision;
 }
 } // namespace morea
