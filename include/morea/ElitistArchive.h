@@ -166,11 +166,6 @@ private:
   /** The first entry from `begin` on that `f` dominates, or Size(). */
   std::size_t
   FirstDominatedBy(const ObjectiveVector & f, std::size_t begin) const;
-  /** Entry `i`'s objectives and grid cell, from the columns. */
-  ObjectiveVector
-  ObjectivesAt(std::size_t i) const;
-  ObjectiveVector
-  CellAt(std::size_t i) const;
   /** Appends an entry's objectives and cell to the columns. */
   void
   AppendColumns(const ObjectiveVector & objectives, const ObjectiveVector & cell);

@@ -218,6 +218,16 @@ struct ColumnView
   const double * cell[M];
 };
 
+/** Entry `i`'s values in `columns` (its objectives, or its cell). */
+ObjectiveVector
+RowOf(const std::array<std::vector<double>, M> & columns, std::size_t i)
+{
+  ObjectiveVector row;
+  for (std::size_t j = 0; j < M; ++j)
+    row[j] = columns[j][i];
+  return row;
+}
+
 ColumnView
 ViewOf(const std::array<std::vector<double>, M> & objectives, const std::array<std::vector<double>, M> & cells)
 {
@@ -393,7 +403,7 @@ ElitistArchive::Judge(const Fitness & f, std::uint64_t witness) const
     return verdict;
   // Dominance first: the refusal that lasts.
   const std::size_t hint = IndexOf(witness);
-  if (hint < m_Serials.size() && EqualsOrDominates(ObjectivesAt(hint), f.objectives))
+  if (hint < m_Serials.size() && EqualsOrDominates(RowOf(m_ObjectiveColumns, hint), f.objectives))
     return verdict;
   // One pass for both refusals: any entry that equals or dominates `f`
   // rejects it; else the hint, or the first entry, that crowds it does.
@@ -405,7 +415,8 @@ ElitistArchive::Judge(const Fitness & f, std::uint64_t witness) const
     return verdict;
   }
   std::size_t crowding = flagged.cell;
-  if (hint < m_Serials.size() && crowding < m_Serials.size() && refuses(ObjectivesAt(hint), CellAt(hint)) == Refusal::Cell)
+  if (hint < m_Serials.size() && crowding < m_Serials.size() &&
+      refuses(RowOf(m_ObjectiveColumns, hint), RowOf(m_CellColumns, hint)) == Refusal::Cell)
     crowding = hint;
   Settle(verdict, Refuser{ crowding, crowding < m_Serials.size() ? Refusal::Cell : Refusal::None });
   return verdict;
@@ -453,7 +464,8 @@ ElitistArchive::FindRefuser(const EntryTest & refuses, std::size_t first, std::s
 {
   for (std::size_t hint : { first, second })
     if (hint < m_Serials.size())
-      if (const Refusal refusal = refuses(ObjectivesAt(hint), CellAt(hint)); refusal != Refusal::None)
+      if (const Refusal refusal = refuses(RowOf(m_ObjectiveColumns, hint), RowOf(m_CellColumns, hint));
+          refusal != Refusal::None)
         return Refuser{ hint, refusal };
   return FirstRefuserFrom(refuses, 0);
 }
@@ -481,9 +493,11 @@ ElitistArchive::ScanColumns(const EntryTest & refuses, std::size_t begin, bool s
   for (std::size_t at = begin; at < size; at += ScanBlock)
   {
     const std::size_t count = std::min(ScanBlock, size - at);
-    const BlockFlags  flags = count < ScanBlock ? (cells ? FlagEntries<true>(v, at, count, f, fc)
-                                                         : FlagEntries<false>(v, at, count, f, fc))
-                                                : (cells ? FlagBlock<true>(v, at, f, fc) : FlagBlock<false>(v, at, f, fc));
+    BlockFlags        flags;
+    if (count < ScanBlock) // the last, partial block
+      flags = cells ? FlagEntries<true>(v, at, count, f, fc) : FlagEntries<false>(v, at, count, f, fc);
+    else
+      flags = cells ? FlagBlock<true>(v, at, f, fc) : FlagBlock<false>(v, at, f, fc);
     if (flags.cell != 0 && found.cell == size)
       found.cell = at + LowestBit(flags.cell);
     if (flags.dominance != 0)
@@ -510,24 +524,6 @@ ElitistArchive::FirstDominatedBy(const ObjectiveVector & f, std::size_t begin) c
       return at + LowestBit(dominated);
   }
   return size;
-}
-
-ObjectiveVector
-ElitistArchive::ObjectivesAt(std::size_t i) const
-{
-  ObjectiveVector y;
-  for (std::size_t j = 0; j < M; ++j)
-    y[j] = m_ObjectiveColumns[j][i];
-  return y;
-}
-
-ObjectiveVector
-ElitistArchive::CellAt(std::size_t i) const
-{
-  ObjectiveVector cell;
-  for (std::size_t j = 0; j < M; ++j)
-    cell[j] = m_CellColumns[j][i];
-  return cell;
 }
 
 void
@@ -587,7 +583,7 @@ ElitistArchive::InsertAccepted(const Fitness & f, const DualMesh & solution, std
   {
     keep.assign(m_Serials.size(), true);
     for (std::size_t i = first; i < m_Serials.size(); ++i)
-      keep[i] = !Dominates(f.objectives, ObjectivesAt(i));
+      keep[i] = !Dominates(f.objectives, RowOf(m_ObjectiveColumns, i));
     Compact(keep, first);
   }
   Append(f, solution, id);
@@ -639,7 +635,7 @@ ElitistArchive::RefreshCells()
 {
   for (std::size_t i = 0; i < m_Serials.size(); ++i)
   {
-    const Cell cell = m_Discretised ? CellOf(ObjectivesAt(i), m_CellWidths) : Cell{};
+    const Cell cell = m_Discretised ? CellOf(RowOf(m_ObjectiveColumns, i), m_CellWidths) : Cell{};
     for (std::size_t j = 0; j < M; ++j)
       m_CellColumns[j][i] = cell[j];
   }
