@@ -463,6 +463,40 @@ TEST(CudaEvaluationBackend, TheFirstGroupSplitInTwoBatchesChangesNoDecision)
   }
 }
 
+TEST(CudaEvaluationBackend, DrawingBatchesAheadChangesNoDecision)
+{
+  // Batches drawn on threads of their own while the device evaluates the
+  // one before: the same decisions as drawing each in the meanwhile.
+  MOREA_REQUIRE_CUDA_DEVICE();
+  OptimiserTestProblem problem;
+  GomeaOptions         here = problem.Options(29, 7);
+  here.drawAheadThreads = 0;
+  here.firstBatchSplit = 2;
+  GomeaOptions ahead = here;
+  ahead.drawAheadThreads = 3;
+  for (const CudaInterpolation interpolation : { CudaInterpolation::Exact, CudaInterpolation::Texture })
+  {
+    auto       backend = CreateCudaEvaluationBackend(*problem.evaluator, 2, interpolation);
+    const auto a = RunToEnd(problem, *backend, here);
+    const auto b = RunToEnd(problem, *backend, ahead);
+    ASSERT_FALSE(a.first.empty()) << backend->Name();
+    ASSERT_EQ(a.first.size(), b.first.size()) << backend->Name();
+    for (std::size_t i = 0; i < a.first.size(); ++i)
+    {
+      EXPECT_EQ(a.first[i].id, b.first[i].id) << backend->Name();
+      EXPECT_EQ(a.first[i].fitness.objectives, b.first[i].fitness.objectives) << backend->Name();
+    }
+    for (std::size_t g = 0; g < a.second.size(); ++g)
+      EXPECT_EQ(a.second[g].accepted, b.second[g].accepted) << backend->Name() << " generation " << g;
+    // Automatic: on beside a device, where the pool has 8 threads or more.
+    GomeaOptions automatic = here;
+    automatic.drawAheadThreads = GomeaOptions::DrawAheadAutomatic;
+    automatic.threads = 8;
+    MoRvGomea optimiser(problem.base, problem.topology, problem.parallel, *problem.constraint, *backend, automatic);
+    EXPECT_EQ(optimiser.DrawAheadThreads(), 6u) << backend->Name();
+  }
+}
+
 TEST(CudaEvaluationBackend, TextureInterpolationStaysCloseToTheCpu)
 {
   MOREA_REQUIRE_CUDA_DEVICE();

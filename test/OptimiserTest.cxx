@@ -217,6 +217,44 @@ TEST(MoRvGomea, TheFirstGroupSplitInTwoBatchesChangesNoDecision)
   EXPECT_EQ(backend->Statistics().batches - beforeLarge, middle - before);
 }
 
+TEST(MoRvGomea, DrawingBatchesAheadChangesNoDecision)
+{
+  // Batches drawn on threads of their own, the one after next while the
+  // current one is evaluated: the same seeds in the same order, so the same
+  // front, whatever the threads and the backend's hand-over.
+  OptimiserTestProblem problem;
+  GomeaOptions         here = problem.Options(29, 7);
+  here.drawAheadThreads = 0;
+  here.firstBatchSplit = 2; // the first group in two batches
+  auto       backend = CreateCpuEvaluationBackend(*problem.evaluator, 2);
+  const auto a = RunToEnd(problem, *backend, here);
+  ASSERT_FALSE(a.empty());
+  for (const std::size_t threads : { 1, 2, 3 })
+  {
+    GomeaOptions ahead = here;
+    ahead.drawAheadThreads = threads;
+    {
+      MoRvGomea optimiser(problem.base, problem.topology, problem.parallel, *problem.constraint, *backend, ahead);
+      EXPECT_EQ(optimiser.DrawAheadThreads(), threads);
+    }
+    EXPECT_EQ(a, RunToEnd(problem, *backend, ahead)) << threads << " draw-ahead threads";
+    ShufflingBackend shuffling(*problem.evaluator); // handed over in parts of random sizes
+    EXPECT_EQ(a, RunToEnd(problem, shuffling, ahead)) << threads << " draw-ahead threads, shuffled";
+  }
+  // Without the split of the first group, too (a generation's first two
+  // batches are then two groups, and the batches are fewer).
+  GomeaOptions whole = here;
+  whole.firstBatchSplit = 0;
+  GomeaOptions wholeAhead = whole;
+  wholeAhead.drawAheadThreads = 2;
+  EXPECT_EQ(RunToEnd(problem, *backend, whole), RunToEnd(problem, *backend, wholeAhead));
+  // Automatic: none beside a backend that evaluates on the host's cores.
+  GomeaOptions automatic = here;
+  automatic.drawAheadThreads = GomeaOptions::DrawAheadAutomatic;
+  MoRvGomea optimiser(problem.base, problem.topology, problem.parallel, *problem.constraint, *backend, automatic);
+  EXPECT_EQ(optimiser.DrawAheadThreads(), 0u);
+}
+
 TEST(MoRvGomea, RefusalBoundsSpareSamplesAndChangeNoDecision)
 {
   // Candidates whose bound (RefusalBound.h) is refused go unsampled; the

@@ -110,3 +110,89 @@ TEST(ThreadPool, SharedPoolsAndCallsWithinCalls)
   a->ParallelFor(1000, [&](std::size_t) { after.fetch_add(1); });
   EXPECT_EQ(after.load(), 1000);
 }
+
+// The background worker runs each job on its own thread, beside the caller,
+// one at a time; Wait returns once the job has ended, with its exception.
+TEST(BackgroundWorker, RunsJobsBesideTheCallerInTurnAndPassesOnTheirErrors)
+{
+  morea::BackgroundWorker worker;
+  worker.Wait(); // none started: returns at once
+  const std::thread::id caller = std::this_thread::get_id();
+  std::thread::id       ran;
+  std::atomic<bool>     release{ false };
+  int                   value = 0;
+  worker.Start([&] {
+    ran = std::this_thread::get_id();
+    while (!release.load())
+      std::this_thread::yield();
+    value = 1;
+  });
+  // Under way: a second job is refused, and the first has not finished.
+  EXPECT_THROW(worker.Start([] {}), std::exception);
+  EXPECT_EQ(value, 0);
+  release.store(true);
+  worker.Wait();
+  EXPECT_EQ(value, 1) << "Wait returns after the job has ended";
+  EXPECT_NE(ran, caller);
+  // Jobs in turn, each seeing what the one before wrote.
+  for (int k = 2; k <= 50; ++k)
+  {
+    worker.Start([&value, k] { value = value == k - 1 ? k : -1; });
+    worker.Wait();
+  }
+  EXPECT_EQ(value, 50);
+  // An error reaches Wait once; until it is collected, no job starts.
+  worker.Start([] { throw std::runtime_error("drawing failed"); });
+  std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  EXPECT_THROW(worker.Start([] {}), std::exception);
+  EXPECT_THROW(worker.Wait(), std::runtime_error);
+  worker.Wait(); // collected: nothing more to report
+  worker.Start([&value] { value = 7; });
+  worker.Wait();
+  EXPECT_EQ(value, 7);
+}
+
+TEST(BackgroundWorker, TheDestructorWaitsForTheJobUnderWay)
+{
+  std::atomic<int> finished{ 0 };
+  {
+    morea::BackgroundWorker worker;
+    worker.Start([&finished] {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      finished.store(1);
+    });
+  }
+  EXPECT_EQ(finished.load(), 1);
+}
+
+#if defined(__linux__)
+#  include <sched.h>
+
+// Idle-priority workers run every index like any others, on threads the
+// scheduler runs only where nothing else wants the core.
+TEST(ThreadPool, IdlePriorityWorkersRunAtIdlePriority)
+{
+  ThreadPool                 pool(4, morea::WorkerPriority::Idle);
+  const std::thread::id      caller = std::this_thread::get_id();
+  std::atomic<int>           ran{ 0 }, idle{ 0 }, others{ 0 };
+  const int                  callerPolicy = sched_getscheduler(0);
+  pool.ParallelFor(20000, [&](std::size_t) {
+    ran.fetch_add(1);
+    if (std::this_thread::get_id() == caller)
+      return;
+    others.fetch_add(1);
+    if (sched_getscheduler(0) == SCHED_IDLE)
+      idle.fetch_add(1);
+    std::this_thread::yield();
+  });
+  EXPECT_EQ(ran.load(), 20000);
+  ASSERT_GT(others.load(), 0) << "the workers took part";
+  EXPECT_EQ(idle.load(), others.load()) << "every worker runs at idle priority";
+  EXPECT_EQ(sched_getscheduler(0), callerPolicy) << "the caller keeps its own";
+  morea::BackgroundWorker worker(morea::WorkerPriority::Idle);
+  int                     policy = -1;
+  worker.Start([&policy] { policy = sched_getscheduler(0); });
+  worker.Wait();
+  EXPECT_EQ(policy, SCHED_IDLE);
+}
+#endif

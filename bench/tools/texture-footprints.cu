@@ -48,7 +48,9 @@ enum Format
   Float3D,
   Ushort3D,
   PairLayers,
-  Float2x3D
+  Float2x3D,
+  QuadRows,
+  Bricks
 };
 
 /** Each warp's fetch i lies in a cube of edge `spread` texels placed at
@@ -73,6 +75,30 @@ Fetch(cudaTextureObject_t t, float spread, float * out)
     {
       const float2 v = tex3D<float2>(t, x, y, z);
       sum += v.x + v.y;
+    }
+    else if (F == QuadRows)
+    {
+      // Row pair floor(y + 1/2) read at its texel centre: no weight on the
+      // next row, so the filter works along x only.
+      const float  s = z + 0.5f, layer = floorf(s), r = y + 0.5f, row = floorf(r);
+      const float4 v = tex2DLayered<float4>(t, x, row + 0.5f, min(max(static_cast<int>(layer), 0), Edge));
+      const float  fy = r - row, lo = fmaf(fy, v.y - v.x, v.x), hi = fmaf(fy, v.w - v.z, v.z);
+      sum += fmaf(s - layer, hi - lo, lo);
+    }
+    else if (F == Bricks)
+    {
+      // One unfiltered 16-byte texel: the 2 x 2 x 2 voxels around the point
+      // as 16-bit values; trilinear in software.
+      const float  sx = x + 0.5f, sy = y + 0.5f, sz = z + 0.5f;
+      const float  ix = floorf(sx), iy = floorf(sy), iz = floorf(sz);
+      const uint4  b = tex3D<uint4>(t, ix + 0.5f, iy + 0.5f, iz + 0.5f);
+      const float  fx = sx - ix, fy = sy - iy, fz = sz - iz;
+      const auto   lo16 = [](std::uint32_t w) { return static_cast<float>(w & 0xffffu); };
+      const auto   hi16 = [](std::uint32_t w) { return static_cast<float>(w >> 16); };
+      const float  x00 = fmaf(fx, hi16(b.x) - lo16(b.x), lo16(b.x)), x10 = fmaf(fx, hi16(b.y) - lo16(b.y), lo16(b.y));
+      const float  x01 = fmaf(fx, hi16(b.z) - lo16(b.z), lo16(b.z)), x11 = fmaf(fx, hi16(b.w) - lo16(b.w), lo16(b.w));
+      const float  y0 = fmaf(fy, x10 - x00, x00), y1 = fmaf(fy, x11 - x01, x01);
+      sum += fmaf(fz, y1 - y0, y0) * (1.0f / 65535.0f);
     }
     else
     {
@@ -135,17 +161,73 @@ main()
   const Texture3D tu(u.data(), 2, cudaCreateChannelDesc<unsigned short>(), volume);
   const Texture3D tp(pairs.data(), 4, cudaCreateChannelDesc<ushort2>(), layers, TextureLayout::Layers);
   const Texture3D t2(f2.data(), 8, cudaCreateChannelDesc<float2>(), volume);
+  // Row pairs of slice pairs (rows j - 1, j of slices l - 1, l), and
+  // 2 x 2 x 2 bricks around each texel corner (voxels i - 1, i per axis).
+  const auto clampAt = [](int i) { return std::min(std::max(i, 0), Edge - 1); };
+  std::vector<std::uint16_t> quads(4 * static_cast<std::size_t>(Edge) * (Edge + 1) * (Edge + 1));
+  for (int l = 0; l <= Edge; ++l)
+    for (int j = 0; j <= Edge; ++j)
+      for (int i = 0; i < Edge; ++i)
+      {
+        std::uint16_t * q = quads.data() + 4 * ((static_cast<std::size_t>(l) * (Edge + 1) + j) * Edge + i);
+        const auto      at = [&](int jj, int ll) { return u[(static_cast<std::size_t>(clampAt(ll)) * Edge + clampAt(jj)) * Edge + i]; };
+        q[0] = at(j - 1, l - 1);
+        q[1] = at(j, l - 1);
+        q[2] = at(j - 1, l);
+        q[3] = at(j, l);
+      }
+  const int       quadLayers[3] = { Edge, Edge + 1, Edge + 1 };
+  const Texture3D tq(quads.data(), 8, cudaCreateChannelDesc<ushort4>(), quadLayers, TextureLayout::Layers);
+  const int                  brickEdge = Edge + 1;
+  std::vector<std::uint32_t> bricks(4 * static_cast<std::size_t>(brickEdge) * brickEdge * brickEdge);
+  for (int k = 0; k < brickEdge; ++k)
+    for (int j = 0; j < brickEdge; ++j)
+      for (int i = 0; i < brickEdge; ++i)
+      {
+        std::uint32_t * b = bricks.data() + 4 * ((static_cast<std::size_t>(k) * brickEdge + j) * brickEdge + i);
+        const auto      at = [&](int ii, int jj, int kk) {
+          return static_cast<std::uint32_t>(
+            u[(static_cast<std::size_t>(clampAt(kk)) * Edge + clampAt(jj)) * Edge + clampAt(ii)]);
+        };
+        for (int c = 0; c < 4; ++c) // c: (y, z) corner; x pair in one word
+          b[c] = at(i - 1, j - 1 + (c & 1), k - 1 + (c >> 1)) | at(i, j - 1 + (c & 1), k - 1 + (c >> 1)) << 16;
+      }
+  cudaArray_t           brickArray = nullptr;
+  cudaChannelFormatDesc brickFormat = cudaCreateChannelDesc<uint4>();
+  Check(cudaMalloc3DArray(&brickArray, &brickFormat, make_cudaExtent(brickEdge, brickEdge, brickEdge)), "bricks");
+  cudaMemcpy3DParms copy{};
+  copy.srcPtr = make_cudaPitchedPtr(bricks.data(), brickEdge * 16, brickEdge, brickEdge);
+  copy.dstArray = brickArray;
+  copy.extent = make_cudaExtent(brickEdge, brickEdge, brickEdge);
+  copy.kind = cudaMemcpyHostToDevice;
+  Check(cudaMemcpy3D(&copy), "bricks up");
+  cudaResourceDesc brickResource{};
+  brickResource.resType = cudaResourceTypeArray;
+  brickResource.res.array.array = brickArray;
+  cudaTextureDesc brickDescription{};
+  brickDescription.addressMode[0] = brickDescription.addressMode[1] = brickDescription.addressMode[2] =
+    cudaAddressModeClamp;
+  brickDescription.filterMode = cudaFilterModePoint;
+  brickDescription.readMode = cudaReadModeElementType;
+  cudaTextureObject_t brickTexture = 0;
+  Check(cudaCreateTextureObject(&brickTexture, &brickResource, &brickDescription, nullptr), "brick texture");
   const int                 threads = 132 * 2048 * 4;
   morea::cuda::DeviceArray<float> buffer(threads);
   float *                         out = buffer.Data();
   cudaDeviceProp p{};
   cudaGetDeviceProperties(&p, 0);
   std::printf("%s; filtered fetches per second (1e9) by the edge of the cube a warp's lanes spread over\n", p.name);
-  std::printf("%8s %12s %12s %12s %12s\n", "edge", "float 3D", "ushort 3D", "pair layers", "float2 3D");
+  std::printf("%8s %12s %12s %12s %12s %12s %12s\n", "edge", "float 3D", "ushort 3D", "pair layers", "float2 3D",
+              "quad rows", "bricks");
   for (float spread : { 0.0f, 1.0f, 2.0f, 3.0f, 4.0f, 6.0f, 8.0f, 12.0f, 16.0f, 32.0f })
-    std::printf("%8.0f %12.1f %12.1f %12.1f %12.1f\n", spread, 1e-9 * Rate<Float3D>(tf.Get(), spread, out, threads),
+    std::printf("%8.0f %12.1f %12.1f %12.1f %12.1f %12.1f %12.1f\n", spread,
+                1e-9 * Rate<Float3D>(tf.Get(), spread, out, threads),
                 1e-9 * Rate<Ushort3D>(tu.Get(), spread, out, threads),
                 1e-9 * Rate<PairLayers>(tp.Get(), spread, out, threads),
-                1e-9 * Rate<Float2x3D>(t2.Get(), spread, out, threads));
+                1e-9 * Rate<Float2x3D>(t2.Get(), spread, out, threads),
+                1e-9 * Rate<QuadRows>(tq.Get(), spread, out, threads),
+                1e-9 * Rate<Bricks>(brickTexture, spread, out, threads));
+  cudaDestroyTextureObject(brickTexture);
+  cudaFreeArray(brickArray);
   return 0;
 }

@@ -287,6 +287,15 @@ public:
   virtual void
   SampleSkipped(const std::vector<PartialCandidate> & candidates, const std::vector<std::size_t> & which) = 0;
 
+  /** Whether EvaluatePartials works beside the calling thread (a device)
+   *  rather than on the host's cores: the optimiser then draws its batches
+   *  ahead on threads of their own (GomeaOptions::drawAheadThreads). */
+  virtual bool
+  EvaluatesBesideHost() const
+  {
+    return false;
+  }
+
   /** Whether skipping candidates by their refusal bound makes runs faster
    *  here (RefusalBoundChoice::Auto): true where sampling is the work that
    *  limits a generation. */

@@ -28,6 +28,7 @@
 #include "morea/Random.h"
 #include "morea/TetrahedralMesh.h"
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <iosfwd>
@@ -37,6 +38,7 @@
 
 namespace morea
 {
+class BackgroundWorker;
 class ParameterSet;
 class ThreadPool;
 
@@ -66,6 +68,18 @@ struct GomeaOptions
    *  generation's start only for the first half. The result does not depend
    *  on it. */
   std::size_t firstBatchSplit{ 64 };
+  /** Threads of their own, at idle priority beside the optimiser's pool,
+   *  that draw a generation's third and later batches of candidates while
+   *  the batch two before is evaluated and accepted, so that the
+   *  optimiser's own thread, which feeds the backend and accepts, does not
+   *  draw them. 0: the optimiser's thread draws the next batch on its pool
+   *  while the backend evaluates the current one (as it always draws the
+   *  first two, which need the generation's new models). DrawAheadAutomatic:
+   *  the pool's threads less 2 where the backend evaluates beside the host
+   *  (EvaluationBackend::EvaluatesBesideHost) and the pool has at least 8,
+   *  otherwise 0. The result does not depend on it. */
+  static constexpr std::size_t DrawAheadAutomatic = ~std::size_t{ 0 };
+  std::size_t                  drawAheadThreads{ DrawAheadAutomatic };
 
   /** ea_* keys, morea_repair_method and seed. */
   static GomeaOptions
@@ -92,7 +106,7 @@ struct GenerationRecord
    *  backend's calls, incl. transfers and waiting for the GPU). */
   struct Phases
   {
-    double sampling{ 0.0 };
+    double sampling{ 0.0 };   ///< drawing candidates here, or waiting for the draw-ahead threads
     double foldChecks{ 0.0 }; ///< incl. repair
     double evaluation{ 0.0 };
     double acceptance{ 0.0 };
@@ -174,6 +188,10 @@ public:
   {
     return m_Options;
   }
+  /** The threads that draw batches ahead (GomeaOptions::drawAheadThreads as
+   *  resolved; 0: none). */
+  std::size_t
+  DrawAheadThreads() const;
   /** Current population and its fitness (after any steering). */
   const std::vector<DualMesh> &
   Population() const
@@ -213,7 +231,7 @@ private:
    *  seed are set) from its cluster's distribution for its element, in
    *  parallel: each candidate has its own random stream. */
   void
-  SampleCandidates(CandidateBatch & batch, const std::vector<ClusterModel> & clusters);
+  SampleCandidates(CandidateBatch & batch, const std::vector<ClusterModel> & clusters, ThreadPool & pool) const;
 
   Fitness
   Steered(const Fitness & raw) const;
@@ -232,7 +250,7 @@ private:
    *  but for what the batch before it may still change: parent keys and
    *  whether a folded candidate is evaluated (ProcessCandidates sets them). */
   void
-  BuildPartials(CandidateBatch & batch) const;
+  BuildPartials(CandidateBatch & batch, ThreadPool & pool) const;
   /** Repairs (when enabled) and evaluates `candidates`, then accepts them in
    *  order; returns how many were accepted. */
   std::size_t
@@ -295,8 +313,12 @@ private:
   EvaluationBackend &       m_Backend;
   GomeaOptions              m_Options;
   std::shared_ptr<ThreadPool> m_Pool; ///< candidate sampling and acceptance (shared with the backend)
-  std::unique_ptr<CandidateBatch> m_Batch; ///< reused by every batch
-  std::unique_ptr<CandidateBatch> m_NextBatch; ///< sampled while m_Batch is evaluated
+  /** A generation's batches take these in turn, kept from batch to batch:
+   *  one evaluated, the next drawn (and packed) meanwhile, and with draw-ahead
+   *  threads the one after drawn too. */
+  std::array<std::unique_ptr<CandidateBatch>, 3> m_Batches;
+  std::unique_ptr<ThreadPool>                    m_DrawPool; ///< the draw-ahead threads, with m_Drawer's
+  std::unique_ptr<BackgroundWorker>              m_Drawer;   ///< draws ahead (GomeaOptions::drawAheadThreads)
 
   std::size_t                             m_Generation{ 0 };
   std::vector<DualMesh>                   m_Population;

@@ -17,11 +17,22 @@
 
 namespace morea
 {
+/** How the operating system schedules a pool's or worker's threads. */
+enum class WorkerPriority
+{
+  Normal,
+  /** Only on cores that nothing else wants (SCHED_IDLE on Linux; Normal
+   *  elsewhere): work beside a latency-bound thread and its pool that must
+   *  never delay them. */
+  Idle
+};
+
 class ThreadPool
 {
 public:
-  /** `threads` = 0: one per hardware thread. The calling thread works too. */
-  explicit ThreadPool(std::size_t threads = 0);
+  /** `threads` = 0: one per hardware thread. The calling thread works too
+   *  (at its own priority; `priority` is that of the workers). */
+  explicit ThreadPool(std::size_t threads = 0, WorkerPriority priority = WorkerPriority::Normal);
   ~ThreadPool();
   ThreadPool(const ThreadPool &) = delete;
   ThreadPool &
@@ -76,6 +87,41 @@ private:
   std::condition_variable    m_Wake;
   std::exception_ptr         m_Error;           ///< under m_Mutex
   std::atomic<bool>          m_Failed{ false }; ///< m_Error is set
+};
+
+/** A thread of its own that runs one job at a time beside its owner: the
+ *  optimiser draws its next batches there while its own thread feeds the
+ *  backend. Start hands a job over; Wait returns once it has ended and
+ *  rethrows what it threw. The destructor waits for a job under way. */
+class BackgroundWorker
+{
+public:
+  explicit BackgroundWorker(WorkerPriority priority = WorkerPriority::Normal);
+  ~BackgroundWorker();
+  BackgroundWorker(const BackgroundWorker &) = delete;
+  BackgroundWorker &
+  operator=(const BackgroundWorker &) = delete;
+
+  /** Runs `job` on the worker's thread; throws while another is under way
+   *  or its error has not been collected by Wait. */
+  void
+  Start(std::function<void()> job);
+  /** Returns when no job is under way (at once when none was started),
+   *  rethrowing the last job's exception, once. */
+  void
+  Wait();
+
+private:
+  void
+  Loop(WorkerPriority priority);
+
+  std::mutex              m_Mutex;
+  std::condition_variable m_Changed;
+  std::function<void()>   m_Job;          ///< under m_Mutex
+  bool                    m_Busy{ false }; ///< a job is handed over or running; under m_Mutex
+  bool                    m_Stop{ false }; ///< under m_Mutex
+  std::exception_ptr      m_Error;        ///< under m_Mutex
+  std::thread             m_Thread;       ///< last: starts once the rest is made
 };
 } // namespace morea
 

@@ -47,6 +47,7 @@ TimeBackend(const std::string & name, const itk::morea::MeshModel & model, const
   std::size_t       memoryPeak = memoryBefore;
   auto              backend = CreateEvaluationBackend(ParseBackendChoice(name), evaluator, threads);
   gomea.boundRefusals = UsesRefusalBounds(refusalBounds, *backend);
+  gomea.threads = threads; // the backend's pool: the two take turns on it
   std::cout << "  backend " << backend->Name() << ": initial population of " << gomea.populationSize << "\n"
             << std::flush;
   auto      start = Clock::now();
@@ -142,6 +143,7 @@ TimeBackend(const std::string & name, const itk::morea::MeshModel & model, const
   const std::size_t       done = perGeneration.size();
   nlohmann::json          out{ { "backend", backend->Name() },
                       { "refusal_bounds", gomea.boundRefusals },
+                      { "draw_ahead_threads", optimiser.DrawAheadThreads() },
                       { "bound_skipped_samples", total.boundSkippedSamples - afterInit.boundSkippedSamples },
                       { "threads", threads ? threads : std::max(1u, std::thread::hardware_concurrency()) },
                       { "first_generation", firstGeneration },
@@ -181,6 +183,7 @@ AddBenchmarkCommand(CLI::App & app)
     bool             probe{ true };
     std::string      checkpoint;
     std::string      refusalBound{ "auto" };
+    std::string      drawAhead{ "auto" };
   };
   auto   options = std::make_shared<Options>();
   auto * cmd = app.add_subcommand("benchmark", "time MO-RV-GOMEA with the CUDA and CPU backends on a problem");
@@ -200,6 +203,11 @@ AddBenchmarkCommand(CLI::App & app)
                   "skip candidates a bound shows refused: on, off, or auto (on with the cpu backend)")
     ->check(CLI::IsMember({ "auto", "on", "off" }))
     ->capture_default_str();
+  cmd->add_option("--draw-ahead", options->drawAhead,
+                  "threads that draw batches of candidates ahead, beside the optimiser's pool: auto, or a count (0: "
+                  "none)")
+    ->check(CLI::IsMember({ "auto" }) | CLI::NonNegativeNumber)
+    ->capture_default_str();
   cmd->add_option("--probe", options->probe, "measure the GPU's coherent trilinear fetch rate")->capture_default_str();
   cmd->callback([options] {
     const auto parameters = options->parameters.Load();
@@ -215,7 +223,9 @@ AddBenchmarkCommand(CLI::App & app)
     const ObjectiveData data = itk::morea::BuildObjectiveData(preprocessed.problem, model, parameters);
     const FoldConstraint constraint(model.topology, model.base.points, parameters.GetReal("morea_fold_volume_fraction"));
     const TetrahedronEvaluator evaluator(model.topology, constraint, model.elasticity, data);
-    const GomeaOptions         gomea = GomeaOptions::FromParameters(parameters);
+    GomeaOptions               gomea = GomeaOptions::FromParameters(parameters);
+    if (options->drawAhead != "auto")
+      gomea.drawAheadThreads = static_cast<std::size_t>(std::stoul(options->drawAhead));
     const auto                 initial = InitialPopulationOptions::FromParameters(parameters);
     std::cout << "mesh: " << model.base.NumberOfPoints() << " points, " << model.base.NumberOfTetrahedra()
               << " tetrahedra, " << model.parallel.elements.size() << " FOS elements in "

@@ -1,5 +1,7 @@
 #include "morea/ThreadPool.h"
 
+#include "morea/Error.h"
+
 #include <algorithm>
 #include <chrono>
 #include <map>
@@ -10,6 +12,8 @@
 #if defined(__linux__)
 #  include <climits>
 #  include <linux/futex.h>
+#  include <pthread.h>
+#  include <sched.h>
 #  include <sys/syscall.h>
 #  include <unistd.h>
 #endif
@@ -61,6 +65,23 @@ WaitWhileUnchanged(std::atomic<std::uint32_t> & word, std::uint32_t seen, std::m
 #endif
 }
 
+/** Puts the calling thread at `priority`; best effort (a refusal leaves it
+ *  as it was). */
+void
+SetOwnPriority(WorkerPriority priority)
+{
+#if defined(__linux__)
+  if (priority == WorkerPriority::Idle)
+  {
+    sched_param parameters{};
+    parameters.sched_priority = 0;
+    pthread_setschedparam(pthread_self(), SCHED_IDLE, &parameters);
+  }
+#else
+  (void)priority;
+#endif
+}
+
 /** Changes the wake word and wakes up to `count` threads waiting on it. */
 void
 ChangeAndWake(std::atomic<std::uint32_t> & word, std::size_t count, std::mutex & mutex, std::condition_variable & wake)
@@ -98,12 +119,15 @@ ThreadPool::Shared(std::size_t threads)
   return pool;
 }
 
-ThreadPool::ThreadPool(std::size_t threads)
+ThreadPool::ThreadPool(std::size_t threads, WorkerPriority priority)
 {
   if (threads == 0)
     threads = std::max<std::size_t>(1, std::thread::hardware_concurrency());
   for (std::size_t i = 1; i < threads; ++i)
-    m_Workers.emplace_back([this] { WorkerLoop(); });
+    m_Workers.emplace_back([this, priority] {
+      SetOwnPriority(priority);
+      WorkerLoop();
+    });
 }
 
 ThreadPool::~ThreadPool()
@@ -245,5 +269,78 @@ ThreadPool::ParallelFor(std::size_t count, const std::function<void(std::size_t)
     m_Failed.store(false);
   }
   std::rethrow_exception(error);
+}
+
+BackgroundWorker::BackgroundWorker(WorkerPriority priority)
+  : m_Thread([this, priority] { Loop(priority); })
+{}
+
+BackgroundWorker::~BackgroundWorker()
+{
+  {
+    std::unique_lock<std::mutex> lock(m_Mutex);
+    m_Changed.wait(lock, [this] { return !m_Busy; });
+    m_Stop = true;
+  }
+  m_Changed.notify_all();
+  m_Thread.join();
+}
+
+void
+BackgroundWorker::Start(std::function<void()> job)
+{
+  if (!job)
+    throw Error("background worker: no job to start");
+  {
+    std::lock_guard<std::mutex> lock(m_Mutex);
+    if (m_Busy || m_Error)
+      throw Error("background worker: a job is under way or its outcome was not collected");
+    m_Job = std::move(job);
+    m_Busy = true;
+  }
+  m_Changed.notify_all();
+}
+
+void
+BackgroundWorker::Wait()
+{
+  std::exception_ptr error;
+  {
+    std::unique_lock<std::mutex> lock(m_Mutex);
+    m_Changed.wait(lock, [this] { return !m_Busy; });
+    std::swap(error, m_Error);
+  }
+  if (error)
+    std::rethrow_exception(error);
+}
+
+void
+BackgroundWorker::Loop(WorkerPriority priority)
+{
+  SetOwnPriority(priority);
+  std::unique_lock<std::mutex> lock(m_Mutex);
+  for (;;)
+  {
+    m_Changed.wait(lock, [this] { return m_Stop || (m_Busy && m_Job); });
+    if (m_Stop)
+      return;
+    std::function<void()> job = std::move(m_Job);
+    m_Job = nullptr;
+    lock.unlock();
+    std::exception_ptr error;
+    try
+    {
+      job();
+    }
+    catch (...)
+    {
+      error = std::current_exception();
+    }
+    job = nullptr; // what it holds goes before Wait returns
+    lock.lock();
+    m_Error = error;
+    m_Busy = false;
+    m_Changed.notify_all();
+  }
 }
 } // namespace morea

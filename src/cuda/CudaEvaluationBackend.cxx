@@ -467,6 +467,12 @@ public:
     m_Statistics.stagingSeconds += SecondsSince(start);
   }
 
+  bool
+  EvaluatesBesideHost() const override
+  {
+    return true;
+  }
+
   /** Yes, since acceptance got cheaper (archive verdicts that last, values
    *  applied in parallel): on an H100, at the paper's scale, 500 generations
    *  took 71.4 s with the bound and 79.9 s without it in one lease, 67.7 s

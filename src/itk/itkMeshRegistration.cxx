@@ -58,6 +58,7 @@ RegisterMeshes(const RegistrationProblem & problem, const ::morea::ParameterSet 
   start = Clock::now();
   ::morea::GomeaOptions gomea = ::morea::GomeaOptions::FromParameters(parameters);
   gomea.boundRefusals = ::morea::UsesRefusalBounds(options.refusalBounds, *backend);
+  gomea.threads = options.threads; // the backend's pool: the two take turns on it
   ::morea::MoRvGomea optimiser(model.base, model.topology, model.parallel, constraint, *backend, gomea);
   if (options.resume && !options.checkpointPath.empty() && std::filesystem::exists(options.checkpointPath))
   {
