@@ -85,6 +85,24 @@ RunToEnd(const OptimiserTestProblem & problem, EvaluationBackend & backend, cons
   optimiser.Run();
   return std::make_pair(optimiser.Archive().Entries(), optimiser.History());
 }
+
+/** Two runs that must have made the same decisions: the same archive (ids
+ *  and objectives) and as many acceptances in every generation. */
+void
+ExpectSameDecisions(const std::pair<std::vector<ArchiveEntry>, std::vector<GenerationRecord>> & a,
+                    const std::pair<std::vector<ArchiveEntry>, std::vector<GenerationRecord>> & b,
+                    const std::string &                                                       name)
+{
+  ASSERT_EQ(a.first.size(), b.first.size()) << name;
+  for (std::size_t i = 0; i < a.first.size(); ++i)
+  {
+    EXPECT_EQ(a.first[i].id, b.first[i].id) << name;
+    EXPECT_EQ(a.first[i].fitness.objectives, b.first[i].fitness.objectives) << name;
+  }
+  ASSERT_EQ(a.second.size(), b.second.size()) << name;
+  for (std::size_t g = 0; g < a.second.size(); ++g)
+    EXPECT_EQ(a.second[g].accepted, b.second[g].accepted) << name << " generation " << g;
+}
 } // namespace
 
 TEST(CudaEvaluationBackend, WholeSolutionsAgreeWithTheCpu)
@@ -448,14 +466,7 @@ TEST(CudaEvaluationBackend, TheFirstGroupSplitInTwoBatchesChangesNoDecision)
     const auto a = run(whole);
     const auto middle = backend->Statistics().startedCandidates;
     const auto b = run(split);
-    ASSERT_EQ(a.first.size(), b.first.size()) << backend->Name();
-    for (std::size_t i = 0; i < a.first.size(); ++i)
-    {
-      EXPECT_EQ(a.first[i].id, b.first[i].id) << backend->Name();
-      EXPECT_EQ(a.first[i].fitness.objectives, b.first[i].fitness.objectives) << backend->Name();
-    }
-    for (std::size_t g = 0; g < a.second.size(); ++g)
-      EXPECT_EQ(a.second[g].accepted, b.second[g].accepted) << backend->Name() << " generation " << g;
+    ExpectSameDecisions(a, b, backend->Name());
     // (These batches are too small for parts, so none is started early
     // here; at the paper's scale the second half is.)
     std::cout << backend->Name() << ": started early " << middle - started << " candidates whole, "
@@ -480,14 +491,7 @@ TEST(CudaEvaluationBackend, DrawingBatchesAheadChangesNoDecision)
     const auto a = RunToEnd(problem, *backend, here);
     const auto b = RunToEnd(problem, *backend, ahead);
     ASSERT_FALSE(a.first.empty()) << backend->Name();
-    ASSERT_EQ(a.first.size(), b.first.size()) << backend->Name();
-    for (std::size_t i = 0; i < a.first.size(); ++i)
-    {
-      EXPECT_EQ(a.first[i].id, b.first[i].id) << backend->Name();
-      EXPECT_EQ(a.first[i].fitness.objectives, b.first[i].fitness.objectives) << backend->Name();
-    }
-    for (std::size_t g = 0; g < a.second.size(); ++g)
-      EXPECT_EQ(a.second[g].accepted, b.second[g].accepted) << backend->Name() << " generation " << g;
+    ExpectSameDecisions(a, b, backend->Name());
     // Automatic: on beside a device, where the pool has 8 threads or more.
     GomeaOptions automatic = here;
     automatic.drawAheadThreads = GomeaOptions::DrawAheadAutomatic;
