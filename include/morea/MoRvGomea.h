@@ -244,8 +244,11 @@ private:
   std::vector<ClusterModel>
   BuildClusters(const std::vector<std::size_t> & selection, const std::vector<Fitness> & fitness,
                 RandomGenerator & random);
+  /** Each cluster's distributions for `elements`, on `pool`; the first call
+   *  of a generation sizes the clusters' models for every element. */
   void
-  EstimateDistributions(std::vector<ClusterModel> & clusters) const;
+  EstimateDistributions(std::vector<ClusterModel> & clusters, const std::vector<std::uint32_t> & elements,
+                        ThreadPool & pool) const;
   /** The backend's view of a drawn batch (PartialCandidate per candidate),
    *  but for what the batch before it may still change: parent keys and
    *  whether a folded candidate is evaluated (ProcessCandidates sets them). */

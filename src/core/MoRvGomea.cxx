@@ -710,7 +710,8 @@ MoRvGomea::BuildClusters(const std::vector<std::size_t> & selection, const std::
 }
 
 void
-MoRvGomea::EstimateDistributions(std::vector<ClusterModel> & clusters) const
+MoRvGomea::EstimateDistributions(std::vector<ClusterModel> & clusters, const std::vector<std::uint32_t> & elements,
+                                 ThreadPool & pool) const
 {
   // Every (cluster, element) pair is independent: estimate them in parallel.
   std::vector<std::pair<std::size_t, std::size_t>> work;
@@ -719,12 +720,15 @@ MoRvGomea::EstimateDistributions(std::vector<ClusterModel> & clusters) const
     ClusterModel & cluster = clusters[c];
     if (cluster.members.empty() || cluster.population.empty())
       continue;
-    cluster.means.resize(m_Parallel.elements.size());
-    cluster.cholesky.resize(m_Parallel.elements.size());
-    for (std::size_t e = 0; e < m_Parallel.elements.size(); ++e)
+    if (cluster.means.size() != m_Parallel.elements.size()) // the first call sizes them
+    {
+      cluster.means.resize(m_Parallel.elements.size());
+      cluster.cholesky.resize(m_Parallel.elements.size());
+    }
+    for (std::uint32_t e : elements)
       work.emplace_back(c, e);
   }
-  m_Pool->ParallelFor(work.size(), [&](std::size_t w) {
+  pool.ParallelFor(work.size(), [&](std::size_t w) {
     ClusterModel &      cluster = clusters[work[w].first];
     const std::size_t   e = work[w].second;
     const double        count = static_cast<double>(cluster.members.size());
@@ -1294,13 +1298,30 @@ MoRvGomea::RunGeneration()
   const std::vector<Fitness>     fitness = PopulationFitness();
   const std::vector<std::size_t> selection = Select(fitness, random);
   std::vector<ClusterModel>      clusters = BuildClusters(selection, fitness, random);
-  EstimateDistributions(clusters);
-  record.phaseSeconds.modelling = SecondsSince(start);
 
   std::vector<std::size_t> groupOrder(m_Parallel.groups.size());
   std::iota(groupOrder.begin(), groupOrder.end(), std::size_t{ 0 });
   for (std::size_t i = groupOrder.size(); i > 1; --i)
     std::swap(groupOrder[i - 1], groupOrder[static_cast<std::size_t>(random.Uniform() * static_cast<double>(i))]);
+  // The distributions of the first group's elements now; the others' (most
+  // of the estimation) while the backend evaluates the first batch, before
+  // a batch of another group is drawn (laterModels): the device then waits
+  // at the generation's start for one group's models only. (Estimation was
+  // a fifth of the main thread's work while the device waited there, late
+  // in a paper-scale run on an H100 host: about 1.3 ms a generation.)
+  const std::vector<std::uint32_t> firstGroup =
+    groupOrder.empty() ? std::vector<std::uint32_t>{} : m_Parallel.groups[groupOrder.front()];
+  std::vector<std::uint32_t> otherElements;
+  {
+    std::vector<bool> first(m_Parallel.elements.size(), false);
+    for (std::uint32_t e : firstGroup)
+      first[e] = true;
+    for (std::uint32_t e = 0; e < m_Parallel.elements.size(); ++e)
+      if (!first[e])
+        otherElements.push_back(e);
+  }
+  EstimateDistributions(clusters, firstGroup, *m_Pool);
+  record.phaseSeconds.modelling = SecondsSince(start);
 
   const std::size_t elements = m_Parallel.elements.size();
   std::vector<bool> improved(m_Population.size(), false);
@@ -1394,12 +1415,20 @@ MoRvGomea::RunGeneration()
     });
     SampleCandidates(next, clusters, pool);
   };
+  // Whether the other elements' distributions are estimated, or are being
+  // estimated ahead of the batch drawn ahead that first needs them.
+  bool       laterModels = otherElements.empty();
+  const auto needsLaterModels = [&](std::size_t i) { return !laterModels && spans[i].group != groupOrder.front(); };
   // The span the draw-ahead threads draw or have drawn (none: spans.size()).
   std::size_t drawnAhead = spans.size();
   const auto  drawAhead = [&](std::size_t i) {
     seedBatch(spans[i], slot(i));
     drawnAhead = i;
-    m_Drawer->Start([&, i] {
+    const bool estimate = needsLaterModels(i);
+    laterModels = laterModels || estimate;
+    m_Drawer->Start([&, i, estimate] {
+      if (estimate)
+        EstimateDistributions(clusters, otherElements, *m_DrawPool);
       drawBatch(spans[i], slot(i), *m_DrawPool);
       BuildPartials(slot(i), *m_DrawPool);
     });
@@ -1436,8 +1465,15 @@ MoRvGomea::RunGeneration()
     if (i + 1 < spans.size())
       drawNext = [&, i] {
         CandidateBatch & next = slot(i + 1);
-        const auto       sampling = std::chrono::steady_clock::now();
         const bool       drawn = drawnAhead == i + 1;
+        if (!drawn && needsLaterModels(i + 1))
+        {
+          const auto modelling = std::chrono::steady_clock::now();
+          EstimateDistributions(clusters, otherElements, *m_Pool);
+          laterModels = true;
+          record.phaseSeconds.modelling += SecondsSince(modelling);
+        }
+        const auto sampling = std::chrono::steady_clock::now();
         if (drawn)
           m_Drawer->Wait();
         else
@@ -1471,6 +1507,12 @@ MoRvGomea::RunGeneration()
   }
   if (m_Drawer)
     m_Drawer->Wait(); // a backend that never called drawNext
+  if (!laterModels) // a backend that never called drawNext: the multipliers below read every model
+  {
+    const auto modelling = std::chrono::steady_clock::now();
+    EstimateDistributions(clusters, otherElements, *m_Pool);
+    record.phaseSeconds.modelling += SecondsSince(modelling);
+  }
   const auto bookkeeping = std::chrono::steady_clock::now();
   double     forcedSeconds = 0.0;
 
