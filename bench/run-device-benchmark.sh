@@ -31,6 +31,8 @@
 #   Late generations of several builds: bench/run-device-benchmark.sh late-ab OUTDIR SECONDS BACKEND
 #                  GENERATIONS ROUNDS PROGRAM... times GENERATIONS from one common checkpoint
 #                  per program, in turns; one summary line and the device phases each.
+#                  Options of one build compare the same way: a PROGRAM may be a script
+#                  that runs `exec /tmp/b/bin/morea "$@" --draw-ahead 0` (benchmark options).
 #   The whole command: bench/run-device-benchmark.sh command OUTDIR ROUNDS BACKEND PROGRAM...
 #                  runs a plain `morea register` (reading to outputs) per PROGRAM in turns.
 #   Refusal bound: bench/run-device-benchmark.sh bound OUTDIR SECONDS BACKEND GENERATIONS [ROUNDS [PROGRAM...]]
