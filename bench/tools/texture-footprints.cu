@@ -192,25 +192,9 @@ main()
         for (int c = 0; c < 4; ++c) // c: (y, z) corner; x pair in one word
           b[c] = at(i - 1, j - 1 + (c & 1), k - 1 + (c >> 1)) | at(i, j - 1 + (c & 1), k - 1 + (c >> 1)) << 16;
       }
-  cudaArray_t           brickArray = nullptr;
-  cudaChannelFormatDesc brickFormat = cudaCreateChannelDesc<uint4>();
-  Check(cudaMalloc3DArray(&brickArray, &brickFormat, make_cudaExtent(brickEdge, brickEdge, brickEdge)), "bricks");
-  cudaMemcpy3DParms copy{};
-  copy.srcPtr = make_cudaPitchedPtr(bricks.data(), brickEdge * 16, brickEdge, brickEdge);
-  copy.dstArray = brickArray;
-  copy.extent = make_cudaExtent(brickEdge, brickEdge, brickEdge);
-  copy.kind = cudaMemcpyHostToDevice;
-  Check(cudaMemcpy3D(&copy), "bricks up");
-  cudaResourceDesc brickResource{};
-  brickResource.resType = cudaResourceTypeArray;
-  brickResource.res.array.array = brickArray;
-  cudaTextureDesc brickDescription{};
-  brickDescription.addressMode[0] = brickDescription.addressMode[1] = brickDescription.addressMode[2] =
-    cudaAddressModeClamp;
-  brickDescription.filterMode = cudaFilterModePoint;
-  brickDescription.readMode = cudaReadModeElementType;
-  cudaTextureObject_t brickTexture = 0;
-  Check(cudaCreateTextureObject(&brickTexture, &brickResource, &brickDescription, nullptr), "brick texture");
+  const int       brickSize[3] = { brickEdge, brickEdge, brickEdge };
+  const Texture3D tb(bricks.data(), 16, cudaCreateChannelDesc<uint4>(), brickSize, TextureLayout::Volume,
+                     morea::cuda::TextureFilter::Point);
   const int                 threads = 132 * 2048 * 4;
   morea::cuda::DeviceArray<float> buffer(threads);
   float *                         out = buffer.Data();
@@ -226,8 +210,6 @@ main()
                 1e-9 * Rate<PairLayers>(tp.Get(), spread, out, threads),
                 1e-9 * Rate<Float2x3D>(t2.Get(), spread, out, threads),
                 1e-9 * Rate<QuadRows>(tq.Get(), spread, out, threads),
-                1e-9 * Rate<Bricks>(brickTexture, spread, out, threads));
-  cudaDestroyTextureObject(brickTexture);
-  cudaFreeArray(brickArray);
+                1e-9 * Rate<Bricks>(tb.Get(), spread, out, threads));
   return 0;
 }

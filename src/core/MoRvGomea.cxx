@@ -1505,14 +1505,6 @@ MoRvGomea::RunGeneration()
         ++acceptedCount[cand.cluster][cand.element];
       }
   }
-  if (m_Drawer)
-    m_Drawer->Wait(); // a backend that never called drawNext
-  if (!laterModels) // a backend that never called drawNext: the multipliers below read every model
-  {
-    const auto modelling = std::chrono::steady_clock::now();
-    EstimateDistributions(clusters, otherElements, *m_Pool);
-    record.phaseSeconds.modelling += SecondsSince(modelling);
-  }
   const auto bookkeeping = std::chrono::steady_clock::now();
   double     forcedSeconds = 0.0;
 

@@ -148,8 +148,9 @@ private:
   cudaStream_t m_Stream{ nullptr };
 };
 /** A 3D texture with trilinear filtering (clamped, unnormalised
- *  coordinates), owning its array. `voxels` holds `bytesPerVoxel` bytes per
- *  voxel in `format`; integer formats read as normalised floats. With
+ *  coordinates; or none, TextureFilter::Point), owning its array. `voxels`
+ *  holds `bytesPerVoxel` bytes per voxel in `format`; integer formats read
+ *  as normalised floats where filtered. With
  *  `TextureLayout::Layers`, size[2] counts 2D layers, each filtered
  *  bilinearly on its own (tex2DLayered). */
 enum class TextureLayout
@@ -158,11 +159,19 @@ enum class TextureLayout
   Layers
 };
 
+/** Filtered (linear; integer texels read as normalised floats) or not
+ *  (point; texels read as stored). */
+enum class TextureFilter
+{
+  Linear,
+  Point
+};
+
 class Texture3D
 {
 public:
   Texture3D(const void * voxels, std::size_t bytesPerVoxel, const cudaChannelFormatDesc & format, const int size[3],
-            TextureLayout layout = TextureLayout::Volume)
+            TextureLayout layout = TextureLayout::Volume, TextureFilter filter = TextureFilter::Linear)
   {
     const cudaExtent extent = make_cudaExtent(size[0], size[1], size[2]);
     Check(cudaMalloc3DArray(&m_Array, &format, extent, layout == TextureLayout::Layers ? cudaArrayLayered : 0),
@@ -178,9 +187,10 @@ public:
     resource.res.array.array = m_Array;
     cudaTextureDesc description{};
     description.addressMode[0] = description.addressMode[1] = description.addressMode[2] = cudaAddressModeClamp;
-    description.filterMode = cudaFilterModeLinear;
-    description.readMode =
-      format.f == cudaChannelFormatKindFloat ? cudaReadModeElementType : cudaReadModeNormalizedFloat;
+    description.filterMode = filter == TextureFilter::Linear ? cudaFilterModeLinear : cudaFilterModePoint;
+    description.readMode = format.f == cudaChannelFormatKindFloat || filter == TextureFilter::Point
+                             ? cudaReadModeElementType
+                             : cudaReadModeNormalizedFloat;
     description.normalizedCoords = 0;
     Check(cudaCreateTextureObject(&m_Texture, &resource, &description, nullptr), "creating a texture");
   }
