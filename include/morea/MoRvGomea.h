@@ -249,6 +249,12 @@ private:
   void
   EstimateDistributions(std::vector<ClusterModel> & clusters, const std::vector<std::uint32_t> & elements,
                         ThreadPool & pool) const;
+  /** After a generation: each cluster's and element's multiplier and
+   *  stall count from the mean of its accepted samples (sum and count). */
+  void
+  UpdateDistributionStates(const std::vector<ClusterModel> &                         clusters,
+                           const std::vector<std::vector<std::vector<double>>> & acceptedSum,
+                           const std::vector<std::vector<std::size_t>> &         acceptedCount);
   /** The backend's view of a drawn batch (PartialCandidate per candidate),
    *  but for what the batch before it may still change: parent keys and
    *  whether a folded candidate is evaluated (ProcessCandidates sets them). */
