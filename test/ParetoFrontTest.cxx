@@ -139,26 +139,84 @@ TEST(ParetoFront, RanksAgreeWithDefinitionOnRandomPopulation)
   }
 }
 
-TEST(ParetoFront, RanksOnAPoolAreThoseOfOneThread)
+namespace
 {
-  // Many ties and fronts: objectives on a coarse grid, a third infeasible.
-  morea::RandomGenerator random(11);
-  std::vector<Fitness>   population;
-  for (int i = 0; i < 700; ++i)
+/** Deb's ranks by their definition: peel off the solutions no remaining
+ *  one dominates, front by front (all pairs, every round). */
+std::vector<std::size_t>
+RanksByPeeling(const std::vector<Fitness> & population)
+{
+  const std::size_t        n = population.size();
+  std::vector<std::size_t> ranks(n, n);
+  for (std::size_t rank = 0, left = n; left > 0; ++rank)
   {
-    Fitness f = Feasible(std::floor(random.Uniform(0.0, 6.0)), std::floor(random.Uniform(0.0, 6.0)),
-                         std::floor(random.Uniform(0.0, 6.0)));
-    if (random.Uniform() < 0.3)
+    std::vector<std::size_t> front;
+    for (std::size_t i = 0; i < n; ++i)
     {
-      f.feasible = false;
-      f.constraint = std::floor(random.Uniform(0.0, 4.0));
+      if (ranks[i] != n)
+        continue;
+      bool dominated = false;
+      for (std::size_t k = 0; k < n && !dominated; ++k)
+        dominated = ranks[k] == n && morea::ConstraintDominates(population[k], population[i]);
+      if (!dominated)
+        front.push_back(i);
     }
-    population.push_back(f);
+    for (std::size_t i : front)
+      ranks[i] = rank;
+    left -= front.size();
   }
-  const auto       single = morea::NonDominatedRanks(population);
-  morea::ThreadPool pool(4);
-  EXPECT_EQ(morea::NonDominatedRanks(population, &pool), single);
-  EXPECT_GT(*std::max_element(single.begin(), single.end()), 3u) << "several fronts";
+  return ranks;
+}
+} // namespace
+
+TEST(ParetoFront, RanksAreThoseOfPeelingFrontsOffOnPopulationsOfEveryShape)
+{
+  // Shapes the optimiser meets: scattered (many fronts), near one surface
+  // (a large first front, as late in a run), exactly on it (one front),
+  // coarse grids (ties and identical solutions) and infeasible ones.
+  morea::RandomGenerator random(11);
+  for (int shape = 0; shape < 5; ++shape)
+    for (int round = 0; round < 4; ++round)
+    {
+      std::vector<Fitness> population;
+      for (int i = 0; i < 400; ++i)
+      {
+        const double a = random.Uniform(), b = random.Uniform() * (1.0 - a), c = 1.0 - a - b;
+        const double noise = shape == 1 ? 0.01 : 0.0;
+        Fitness      f = Feasible(a, b, c);
+        if (shape == 0)
+          f = Feasible(random.Uniform(), random.Uniform(), random.Uniform());
+        else if (shape == 3)
+          f = Feasible(std::floor(random.Uniform(0.0, 6.0)), std::floor(random.Uniform(0.0, 6.0)),
+                       std::floor(random.Uniform(0.0, 6.0)));
+        else if (shape == 4)
+          f = Feasible(std::floor(random.Uniform(0.0, 3.0)), std::floor(random.Uniform(0.0, 3.0)),
+                       std::floor(random.Uniform(0.0, 3.0)));
+        for (double & o : f.objectives)
+          o += noise * random.Uniform();
+        if (random.Uniform() < (round == 0 ? 0.0 : 0.1 * round))
+        {
+          f.feasible = false;
+          f.constraint = std::floor(random.Uniform(0.0, 5.0));
+        }
+        population.push_back(f);
+      }
+      const auto ranks = morea::NonDominatedRanks(population);
+      ASSERT_EQ(ranks, RanksByPeeling(population)) << "shape " << shape << ", round " << round;
+      if (shape == 2 && round == 0)
+        EXPECT_EQ(*std::max_element(ranks.begin(), ranks.end()), 0u) << "all on one surface: one front";
+      if (shape == 0 || shape == 3)
+        EXPECT_GT(*std::max_element(ranks.begin(), ranks.end()), 3u) << "several fronts";
+    }
+}
+
+TEST(ParetoFront, RanksCountANotANumberAsTheWorst)
+{
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  // NaN in any objective: worse than the same solution with a number there.
+  const std::vector<Fitness> population{ Feasible(nan, 1.0, 1.0), Feasible(1.0, 1.0, 1.0), Feasible(0.0, nan, 0.0),
+                                         Feasible(0.0, 2.0, 0.0) };
+  EXPECT_EQ(morea::NonDominatedRanks(population), (std::vector<std::size_t>{ 1, 0, 1, 0 }));
 }
 
 TEST(ParetoFront, HypervolumeOfHandComputedSets)

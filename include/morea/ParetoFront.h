@@ -55,12 +55,11 @@ Dominates(const ObjectiveVector & a, const ObjectiveVector & b)
 bool
 ConstraintDominates(const Fitness & a, const Fitness & b);
 
-class ThreadPool;
-
-/** Non-domination rank under constraint domination: 0 for the first front.
- *  With a pool, the comparisons run on it (the ranks are the same). */
+/** Non-domination rank under constraint domination: 0 for the first front
+ *  (O(n log^2 n) for 3 objectives; a NaN objective or constraint counts as
+ *  +infinity). */
 std::vector<std::size_t>
-NonDominatedRanks(const std::vector<Fitness> & population, ThreadPool * pool = nullptr);
+NonDominatedRanks(const std::vector<Fitness> & population);
 
 /** Hypervolume dominated by `points` and bounded by `reference` (3 objectives,
  *  exact). Points not strictly better than the reference in every objective

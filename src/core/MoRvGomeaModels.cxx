@@ -124,7 +124,7 @@ MoRvGomea::Select(const std::vector<Fitness> & fitness, RandomGenerator & random
   const std::size_t wanted = std::min(
     n, std::max<std::size_t>(m_Options.numberOfClusters,
                              static_cast<std::size_t>(std::ceil(m_Options.selectionFraction * static_cast<double>(n)))));
-  const std::vector<std::size_t> ranks = NonDominatedRanks(fitness, m_Pool.get());
+  const std::vector<std::size_t> ranks = NonDominatedRanks(fitness);
   std::vector<std::size_t>       order(n);
   std::iota(order.begin(), order.end(), std::size_t{ 0 });
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return ranks[a] < ranks[b]; });

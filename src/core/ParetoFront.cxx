@@ -1,9 +1,10 @@
 #include "morea/ParetoFront.h"
 
 #include "morea/Error.h"
-#include "morea/ThreadPool.h"
 
 #include <algorithm>
+#include <array>
+#include <limits>
 #include <cmath>
 #include <iterator>
 #include <map>
@@ -160,72 +161,110 @@ ConstraintDominates(const Fitness & a, const Fitness & b)
 
 namespace
 {
-/** ConstraintDominates both ways in one pass: 1 where a dominates b, -1
- *  where b dominates a, 0 where neither does. */
-int
-ConstraintOrder(const Fitness & a, const Fitness & b)
+/** Ranks compare NaN as +infinity (the worst), so that the order below is total. */
+double
+RankKey(double v)
 {
-  if (a.feasible != b.feasible)
-    return a.feasible ? 1 : -1;
-  if (!a.feasible)
-    return a.constraint < b.constraint ? 1 : (b.constraint < a.constraint ? -1 : 0);
-  bool worse = false, better = false;
-  for (std::size_t j = 0; j < a.objectives.size(); ++j)
-  {
-    worse |= a.objectives[j] > b.objectives[j];
-    better |= a.objectives[j] < b.objectives[j];
-  }
-  if (better != worse)
-    return better ? 1 : -1;
-  return 0;
+  return std::isnan(v) ? std::numeric_limits<double>::infinity() : v;
 }
+
+/** One front of feasible solutions, inserted in lexicographic order: the
+ *  members minimal in (objective 1, objective 2) by increasing objective 1
+ *  (and so decreasing objective 2). Every member has objective 0 at most
+ *  that of a later solution, so a member dominates it where it is no worse
+ *  in objectives 1 and 2 and not equal in all three; and where any member
+ *  does, one on this staircase does (a member it hides is no better in 1
+ *  and 2, and a front holds no two equal points but identical ones). */
+class FrontStaircase
+{
+public:
+  using Point = std::array<double, 3>; ///< objectives 1, 2 and 0
+
+  bool
+  Dominates(const Point & p) const
+  {
+    // The step with the largest objective 1 not above p's has the least
+    // objective 2 of all members not above p's in objective 1.
+    const auto next = std::upper_bound(m_Steps.begin(), m_Steps.end(), p[0],
+                                       [](double v, const Point & q) { return v < q[0]; });
+    if (next == m_Steps.begin())
+      return false;
+    const Point & q = *std::prev(next);
+    return q[1] <= p[1] && q != p;
+  }
+  void
+  Insert(const Point & p)
+  {
+    auto at = std::lower_bound(m_Steps.begin(), m_Steps.end(), p[0],
+                               [](const Point & q, double v) { return q[0] < v; });
+    if (at != m_Steps.begin() && std::prev(at)->at(1) <= p[1])
+      return; // a member no worse in 1 and 2 hides p: only one identical to it can
+    if (at != m_Steps.end() && (*at)[0] == p[0] && (*at)[1] <= p[1])
+      return;
+    auto hidden = at;
+    while (hidden != m_Steps.end() && (*hidden)[1] >= p[1])
+      ++hidden;
+    at = m_Steps.erase(at, hidden);
+    m_Steps.insert(at, p);
+  }
+
+private:
+  std::vector<Point> m_Steps; ///< each (objective 1, objective 2, objective 0)
+};
 } // namespace
 
 std::vector<std::size_t>
-NonDominatedRanks(const std::vector<Fitness> & population, ThreadPool * pool)
+NonDominatedRanks(const std::vector<Fitness> & population)
 {
-  // Deb's fast non-dominated sort: count who dominates each solution, then peel
-  // fronts off by releasing the solutions each front dominates. Each solution
-  // is compared with all others on its own (each pair twice, in one pass
-  // for both directions, but rows side by side on the pool: a paper-scale
-  // population's sort took about 4 ms of every generation on one thread).
-  const std::size_t                       n = population.size();
-  std::vector<std::vector<std::uint32_t>> dominatedBy(n); // i -> solutions i dominates
-  std::vector<std::size_t>                dominatorCount(n, 0);
-  const auto                              row = [&](std::size_t i) {
-    for (std::size_t k = 0; k < n; ++k)
-    {
-      if (k == i)
-        continue;
-      const int order = ConstraintOrder(population[i], population[k]);
-      if (order > 0)
-        dominatedBy[i].push_back(static_cast<std::uint32_t>(k));
-      else if (order < 0)
-        ++dominatorCount[i];
-    }
-  };
-  if (pool)
-    pool->ParallelFor(n, row);
-  else
-    for (std::size_t i = 0; i < n; ++i)
-      row(i);
-
-  std::vector<std::size_t> ranks(n, 0);
-  std::vector<std::size_t> front;
-  for (std::size_t i = 0; i < n; ++i)
-    if (dominatorCount[i] == 0)
-      front.push_back(i);
-  for (std::size_t rank = 0; !front.empty(); ++rank)
+  // Feasible solutions in lexicographic order: each one's dominators come
+  // before it, and it belongs to the first front none of whose members
+  // dominates it (constraint domination is transitive, so a front without
+  // its dominator is followed by none with one: the fronts are searched by
+  // bisection). With a staircase per front, a paper-scale population's
+  // ranks take a fraction of a millisecond on one thread where comparing
+  // all pairs took 2.2 ms (1.3 ms on two threads) on the 2-core development
+  // machine. Infeasible solutions follow every feasible front, ranked by
+  // their distinct constraint values.
+  const std::size_t          n = population.size();
+  std::vector<std::size_t>   ranks(n, 0);
+  std::vector<std::uint32_t> feasible, infeasible;
+  std::vector<FrontStaircase::Point> keys(n);
+  for (std::uint32_t i = 0; i < n; ++i)
   {
-    std::vector<std::size_t> nextFront;
-    for (std::size_t i : front)
+    const Fitness & f = population[i];
+    (f.feasible ? feasible : infeasible).push_back(i);
+    keys[i] = { RankKey(f.objectives[0]), RankKey(f.objectives[1]), RankKey(f.objectives[2]) };
+  }
+  std::sort(feasible.begin(), feasible.end(), [&](std::uint32_t a, std::uint32_t b) { return keys[a] < keys[b]; });
+  std::vector<FrontStaircase> fronts;
+  for (std::uint32_t i : feasible)
+  {
+    const FrontStaircase::Point p{ keys[i][1], keys[i][2], keys[i][0] };
+    // Staircase points are (objective 1, objective 2, objective 0): Dominates
+    // compares p's objective 0 as equal or larger, as the order guarantees.
+    std::size_t low = 0, high = fronts.size();
+    while (low < high)
     {
-      ranks[i] = rank;
-      for (std::uint32_t k : dominatedBy[i])
-        if (--dominatorCount[k] == 0)
-          nextFront.push_back(k);
+      const std::size_t middle = (low + high) / 2;
+      if (fronts[middle].Dominates(p))
+        low = middle + 1;
+      else
+        high = middle;
     }
-    front.swap(nextFront);
+    if (low == fronts.size())
+      fronts.emplace_back();
+    fronts[low].Insert(p);
+    ranks[i] = low;
+  }
+  const auto constraint = [&](std::uint32_t i) { return RankKey(population[i].constraint); };
+  std::sort(infeasible.begin(), infeasible.end(),
+            [&](std::uint32_t a, std::uint32_t b) { return constraint(a) < constraint(b); });
+  std::size_t rank = fronts.size();
+  for (std::size_t j = 0; j < infeasible.size(); ++j)
+  {
+    if (j > 0 && constraint(infeasible[j - 1]) < constraint(infeasible[j]))
+      ++rank;
+    ranks[infeasible[j]] = rank;
   }
   return ranks;
 }
