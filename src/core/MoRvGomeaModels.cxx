@@ -143,8 +143,12 @@ MoRvGomea::Select(const std::vector<Fitness> & fitness, RandomGenerator & random
     std::vector<std::size_t> front;
     for (std::size_t j = i; j < n && ranks[order[j]] == ranks[order[i]]; ++j)
       front.push_back(order[j]);
-    const ObjectiveRange range(front, fitness);
-    auto                 norm = [&](std::size_t s) { return range.Normalise(fitness[s]); };
+    // Normalised once: late in a run most of the population can be in this
+    // front, and the loop below visits it once per solution it selects.
+    const ObjectiveRange         range(front, fitness);
+    std::vector<ObjectiveVector> points(front.size());
+    for (std::size_t j = 0; j < front.size(); ++j)
+      points[j] = range.Normalise(fitness[front[j]]);
     std::vector<double> nearest(front.size(), std::numeric_limits<double>::infinity());
     std::vector<bool>   taken(front.size(), false);
     std::size_t         pick = static_cast<std::size_t>(random.Uniform() * static_cast<double>(front.size()));
@@ -152,12 +156,12 @@ MoRvGomea::Select(const std::vector<Fitness> & fitness, RandomGenerator & random
     {
       taken[pick] = true;
       selection.push_back(front[pick]);
-      const ObjectiveVector p = norm(front[pick]);
+      const ObjectiveVector p = points[pick];
       double                far = -1.0;
       for (std::size_t j = 0; j < front.size(); ++j)
         if (!taken[j])
         {
-          nearest[j] = std::min(nearest[j], SquaredDistance(p, norm(front[j])));
+          nearest[j] = std::min(nearest[j], SquaredDistance(p, points[j]));
           if (nearest[j] > far)
           {
             far = nearest[j];
@@ -228,13 +232,14 @@ MoRvGomea::BuildClusters(const std::vector<std::size_t> & selection, const std::
 
   std::vector<ClusterModel> clusters(k + NumberOfObjectives);
   std::vector<std::size_t>  order(points.size());
+  std::vector<double>       distance(points.size());
   for (std::size_t c = 0; c < k; ++c)
   {
     // The clusterSize selected solutions nearest the mean (clusters overlap).
+    for (std::size_t j = 0; j < points.size(); ++j)
+      distance[j] = SquaredDistance(points[j], means[c]);
     std::iota(order.begin(), order.end(), std::size_t{ 0 });
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-      return SquaredDistance(points[a], means[c]) < SquaredDistance(points[b], means[c]);
-    });
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return distance[a] < distance[b]; });
     clusters[c].mean = means[c];
     for (std::size_t j = 0; j < clusterSize; ++j)
       clusters[c].members.push_back(selection[order[j]]);
@@ -269,15 +274,12 @@ MoRvGomea::BuildClusters(const std::vector<std::size_t> & selection, const std::
 
   // Carry the adaptive state over: regular clusters from the nearest previous
   // regular cluster, single-objective ones from their predecessor.
-  const std::size_t                           elements = m_Parallel.elements.size();
-  std::vector<std::vector<DistributionState>> states(clusters.size(),
-                                                     std::vector<DistributionState>(elements));
   const std::size_t previousRegular =
     m_ClusterMeans.size() >= NumberOfObjectives ? m_ClusterMeans.size() - NumberOfObjectives : 0;
-  for (std::size_t c = 0; c < clusters.size(); ++c)
+  constexpr std::size_t    none = std::numeric_limits<std::size_t>::max();
+  std::vector<std::size_t> source(clusters.size(), none);
+  for (std::size_t c = 0; c < clusters.size() && !m_Distributions.empty(); ++c)
   {
-    if (m_Distributions.empty())
-      break;
     std::size_t from = c;
     if (c < k)
     {
@@ -291,8 +293,18 @@ MoRvGomea::BuildClusters(const std::vector<std::size_t> & selection, const std::
     else
       from = previousRegular + (c - k);
     if (from < m_Distributions.size())
-      states[c] = m_Distributions[from];
+      source[c] = from;
   }
+  // Each previous state moves to the last cluster that takes it and is
+  // copied to the others (thousands of vectors a generation).
+  std::vector<std::vector<DistributionState>> states(clusters.size());
+  for (std::size_t c = 0; c < clusters.size(); ++c)
+    if (source[c] == none)
+      states[c].resize(m_Parallel.elements.size());
+    else if (std::find(source.begin() + c + 1, source.end(), source[c]) == source.end())
+      states[c] = std::move(m_Distributions[source[c]]);
+    else
+      states[c] = m_Distributions[source[c]];
   m_Distributions = std::move(states);
   m_ClusterMeans.clear();
   for (const auto & c : clusters)
