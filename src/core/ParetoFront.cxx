@@ -4,9 +4,9 @@
 
 #include <algorithm>
 #include <array>
-#include <limits>
 #include <cmath>
 #include <iterator>
+#include <limits>
 #include <map>
 #include <numeric>
 
@@ -174,7 +174,8 @@ RankKey(double v)
  *  that of a later solution, so a member dominates it where it is no worse
  *  in objectives 1 and 2 and not equal in all three; and where any member
  *  does, one on this staircase does (a member it hides is no better in 1
- *  and 2, and a front holds no two equal points but identical ones). */
+ *  and 2; no two members share objectives 1 and 2 unless they are
+ *  identical, as one would dominate the other). */
 class FrontStaircase
 {
 public:
@@ -228,7 +229,8 @@ NonDominatedRanks(const std::vector<Fitness> & population)
   const std::size_t          n = population.size();
   std::vector<std::size_t>   ranks(n, 0);
   std::vector<std::uint32_t> feasible, infeasible;
-  std::vector<FrontStaircase::Point> keys(n);
+  static_assert(NumberOfObjectives == 3, "the staircases are for 3 objectives");
+  std::vector<std::array<double, 3>> keys(n); // objectives 0, 1 and 2
   for (std::uint32_t i = 0; i < n; ++i)
   {
     const Fitness & f = population[i];
