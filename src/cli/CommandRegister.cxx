@@ -9,6 +9,8 @@
 #include "itkPreprocessing.h"
 #include "itkRigidPreAlignment.h"
 #include "morea/ComputeDevices.h"
+#include "morea/Error.h"
+#include "morea/EvaluationBackend.h"
 
 #include <chrono>
 #include <csignal>
@@ -81,6 +83,13 @@ AddRegisterCommand(CLI::App & app)
     std::cout << "preprocessed: " << r.size[0] << "x" << r.size[1] << "x" << r.size[2] << " voxels of " << r.spacing
               << " mm around '" << r.cropStructure << "'"
               << (r.rigidStructure.empty() ? std::string() : ", rigid on '" + r.rigidStructure + "'") << "\n";
+    // A CUDA backend asked for by name but unusable: said before any output
+    // is written (the context warm-up has long finished by now, so this
+    // costs the run nothing).
+    const ::morea::BackendChoice backend = ::morea::ParseBackendChoice(options->backend);
+    if (backend == ::morea::BackendChoice::Cuda || backend == ::morea::BackendChoice::CudaTexture)
+      if (const std::string reason = ::morea::CudaUnavailableReason(); !reason.empty())
+        throw ::morea::Error("CUDA backend: " + reason + " (--backend auto falls back to the CPU)");
     fs::create_directories(options->output);
     const std::string out = options->output + "/";
     itk::morea::WriteTextFile(parameters.ToToml(), out + "parameters.toml");
@@ -91,7 +100,7 @@ AddRegisterCommand(CLI::App & app)
     run.checkpointInterval = options->checkpointEvery;
     run.resume = options->resume;
     run.threads = options->threads;
-    run.backend = ::morea::ParseBackendChoice(options->backend);
+    run.backend = backend;
     run.refusalBounds = ::morea::ParseRefusalBoundChoice(options->refusalBound);
     run.onGeneration = [print = ProgressPrinter(), killAfter = options->killAfter](
                          const ::morea::GenerationRecord & r, std::size_t total) {

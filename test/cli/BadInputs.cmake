@@ -398,6 +398,13 @@ expect_failure("benchmark: start from a damaged checkpoint" OUTPUTS "${WORK}/ben
   ARGS benchmark --fixed "${fixed}" --moving "${moving}" ${blob} --set ea_population_size=8 --set ea_num_clusters=2
        --set morea_mesh_num_points=40 --set preprocess_rigid_structure=none --backends cpu --probe 0
        --from-checkpoint "${WORK}/benchmark-bad-checkpoint.bin" -o "${WORK}/benchmark-out.json")
+# Without a GPU (as on CI), a CUDA backend asked for by name fails before any output is written.
+if(NOT EXISTS "/dev/nvidia0")
+  expect_failure("register: CUDA without a device" OUTPUTS ${o} FRAGMENTS "CUDA backend" "--backend auto"
+    ARGS register --fixed "${fixed}" --moving "${moving}" ${blob} --set ea_population_size=8 --set ea_num_clusters=2
+         --set ea_num_generations=1 --set morea_mesh_num_points=40 --set preprocess_rigid_structure=none
+         --backend cuda-texture -o "${o}")
+endif()
 expect_failure("mesh: too few points" USAGE OUTPUTS ${o} FRAGMENTS "morea_mesh_num_points"
   ARGS mesh --fixed "${fixed}" --moving "${moving}" ${blob} --set morea_mesh_num_points=4 -o "${o}")
 
