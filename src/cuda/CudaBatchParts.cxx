@@ -108,21 +108,6 @@ CudaEvaluationBackend::ReadFoldChecks(const std::vector<PartialCandidate> & cand
   });
 }
 
-TetrahedronValues
-CudaEvaluationBackend::Unpack(const BatchFlight & f, std::size_t item)
-{
-  const double *    v = f.hostItemValues.Data() + item * cuda::ItemValues;
-  const double *    d = f.hostDirectionValues.Data() + item * 2 * cuda::DirectionValues;
-  TetrahedronValues out;
-  out.magnitude = v[0];
-  out.foldValue = v[1];
-  out.folded = v[2];
-  out.intensity = d[0] + d[3];
-  out.guidance = d[1] + d[4];
-  out.samples = d[2] + d[5];
-  return out;
-}
-
 void
 CudaEvaluationBackend::AddDevicePhases(const BatchFlight & f)
 {

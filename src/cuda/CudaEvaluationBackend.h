@@ -440,8 +440,21 @@ private:
   void
   ReserveItems(BatchFlight & f, std::size_t items);
 
+  /** Inline: the unpacking loops call it once per tetrahedron. */
   static TetrahedronValues
-  Unpack(const BatchFlight & f, std::size_t item);
+  Unpack(const BatchFlight & f, std::size_t item)
+  {
+    const double *    v = f.hostItemValues.Data() + item * cuda::ItemValues;
+    const double *    d = f.hostDirectionValues.Data() + item * 2 * cuda::DirectionValues;
+    TetrahedronValues out;
+    out.magnitude = v[0];
+    out.foldValue = v[1];
+    out.folded = v[2];
+    out.intensity = d[0] + d[3];
+    out.guidance = d[1] + d[4];
+    out.samples = d[2] + d[5];
+    return out;
+  }
 
   /** Candidate c's sum of flight `f` (LaunchSumCandidateValues' layout). */
   static TetrahedronValues
