@@ -103,18 +103,6 @@ MoRvGomea::DrawAheadThreads() const
   return m_DrawPool ? m_DrawPool->NumberOfThreads() : 0;
 }
 
-Fitness
-MoRvGomea::Steered(const Fitness & raw) const
-{
-  return SteeredFitness(raw, m_SteeringLimit);
-}
-
-Fitness
-MoRvGomea::CurrentFitness(std::size_t s) const
-{
-  return Steered(m_Totals[s].ToFitness(m_Topology.NumberOfTetrahedra()));
-}
-
 std::vector<Fitness>
 MoRvGomea::PopulationFitness() const
 {
@@ -142,25 +130,6 @@ MoRvGomea::EvaluatePopulationFully()
       m_Totals[s].Add(v);
     InvalidateElementSums(s);
   }
-}
-
-TetrahedronValues
-MoRvGomea::SumOverElement(std::size_t s, std::size_t e) const
-{
-  // Always in one order, so that a resumed run sums as the uninterrupted
-  // one did.
-  ObjectiveTotals sum;
-  const auto &    stored = m_TetValues[s];
-  for (std::uint32_t t : m_Parallel.elements[e].dependentTetrahedra)
-    sum.Add(stored[t]);
-  return sum.sum;
-}
-
-TetrahedronValues
-MoRvGomea::ElementSum(std::size_t s, std::size_t e) const
-{
-  const std::size_t at = s * m_Parallel.elements.size() + e;
-  return m_ElementSumStale[at] ? SumOverElement(s, e) : m_ElementSums[at];
 }
 
 void

@@ -15,6 +15,39 @@
 
 namespace morea
 {
+// Small helpers the acceptance calls once per candidate, defined here so
+// that they inline there.
+Fitness
+MoRvGomea::Steered(const Fitness & raw) const
+{
+  return SteeredFitness(raw, m_SteeringLimit);
+}
+
+Fitness
+MoRvGomea::CurrentFitness(std::size_t s) const
+{
+  return Steered(m_Totals[s].ToFitness(m_Topology.NumberOfTetrahedra()));
+}
+
+TetrahedronValues
+MoRvGomea::SumOverElement(std::size_t s, std::size_t e) const
+{
+  // Always in one order, so that a resumed run sums as the uninterrupted
+  // one did.
+  ObjectiveTotals sum;
+  const auto &    stored = m_TetValues[s];
+  for (std::uint32_t t : m_Parallel.elements[e].dependentTetrahedra)
+    sum.Add(stored[t]);
+  return sum.sum;
+}
+
+TetrahedronValues
+MoRvGomea::ElementSum(std::size_t s, std::size_t e) const
+{
+  const std::size_t at = s * m_Parallel.elements.size() + e;
+  return m_ElementSumStale[at] ? SumOverElement(s, e) : m_ElementSums[at];
+}
+
 void
 MoRvGomea::BuildPartials(CandidateBatch & candidateBatch, ThreadPool & pool) const
 {
