@@ -3,7 +3,6 @@
 #include "morea/Error.h"
 #include "morea/ParetoFront.h"
 #include "morea/Random.h"
-#include "morea/ThreadPool.h"
 
 #include <gtest/gtest.h>
 

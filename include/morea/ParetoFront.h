@@ -49,6 +49,16 @@ Dominates(const ObjectiveVector & a, const ObjectiveVector & b)
   return !worse && better;
 }
 
+/** Squared Euclidean distance of two objective vectors. */
+inline double
+SquaredDistance(const ObjectiveVector & a, const ObjectiveVector & b)
+{
+  double d = 0.0;
+  for (std::size_t j = 0; j < a.size(); ++j)
+    d += (a[j] - b[j]) * (a[j] - b[j]);
+  return d;
+}
+
 /** Constraint domination (Deb): feasible beats infeasible; of two infeasible
  *  solutions the smaller constraint value wins; two feasible ones compare by
  *  Pareto dominance. */

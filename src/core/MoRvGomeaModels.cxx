@@ -32,15 +32,6 @@ Normalised(double v, double low, double high)
   return high > low ? (v - low) / (high - low) : 0.0;
 }
 
-double
-SquaredDistance(const ObjectiveVector & a, const ObjectiveVector & b)
-{
-  double s = 0.0;
-  for (std::size_t m = 0; m < NumberOfObjectives; ++m)
-    s += (a[m] - b[m]) * (a[m] - b[m]);
-  return s;
-}
-
 /** Per-objective range of a set of solutions, mapping objectives to [0, 1]. */
 struct ObjectiveRange
 {

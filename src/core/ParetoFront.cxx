@@ -71,15 +71,6 @@ Sum(const ObjectiveVector & v)
   return std::accumulate(v.begin(), v.end(), 0.0);
 }
 
-double
-SquaredDistance(const ObjectiveVector & a, const ObjectiveVector & b)
-{
-  double d = 0.0;
-  for (std::size_t j = 0; j < M; ++j)
-    d += (a[j] - b[j]) * (a[j] - b[j]);
-  return d;
-}
-
 /** Index of the smallest score; the first one on ties. */
 template <typename Score>
 std::size_t
