@@ -392,10 +392,11 @@ SamplePoint(const SamplingConstants & k, const float4 * corners, bool near, cons
   const cudaTextureObject_t toIntensity = Direction == 0 ? k.fixedIntensity : k.movingIntensity;
   const std::uint8_t *      fromNearBlocks = Direction == 0 ? k.movingNearBlocks : k.fixedNearBlocks;
   const int *               fromBlocks = Direction == 0 ? k.movingBlocks : k.fixedBlocks;
-  float                     w[4], sum = 0.0f;
+  float w[4];
 #pragma unroll
   for (int d = 0; d < 4; ++d)
-    sum += (w[d] = 32.0f - Log2Approximate(__uint2float_rn(state[d]) + 0.5f)); // -log2 u, u = (state + 1/2) / 2^32
+    w[d] = 32.0f - Log2Approximate(__uint2float_rn(state[d]) + 0.5f); // -log2 u, u = (state + 1/2) / 2^32
+  const float sum = ((w[0] + w[1]) + w[2]) + w[3]; // 0 + w[0] + ... without the 0 (the weights are not -0)
   const float inverseSum = ReciprocalApproximate(sum);
   const float b1 = w[1] * inverseSum, b2 = w[2] * inverseSum, b3 = w[3] * inverseSum;
   // Corners from shared memory (broadcast loads): 51 registers instead
@@ -439,19 +440,24 @@ SamplePoint(const SamplingConstants & k, const float4 * corners, bool near, cons
   // samples of a task near a contour are not, and few are near two.
   if (near)
   {
+    // One test for the common case of no structure near the sample, not
+    // one per structure.
     const unsigned structures = NearStructures(fromNearBlocks, fromBlocks, p);
+    if (structures != 0)
+    {
 #pragma unroll
-    for (int g = 0; g < MaxTextureStructures; ++g)
-      if ((structures >> g) & 1u)
-      {
-        const float d = tex3D<float>(Direction == 0 ? k.movingDistances[g] : k.fixedDistances[g], p[0], p[1], p[2]);
-        if (d < k.radius)
+      for (int g = 0; g < MaxTextureStructures; ++g)
+        if ((structures >> g) & 1u)
         {
-          const float e =
-            d - tex3D<float>(Direction == 0 ? k.fixedDistances[g] : k.movingDistances[g], r[0], r[1], r[2]);
-          guidance += k.guidanceWeights[g] * (k.radius - d) * k.inverseRadius * e * e;
+          const float d = tex3D<float>(Direction == 0 ? k.movingDistances[g] : k.fixedDistances[g], p[0], p[1], p[2]);
+          if (d < k.radius)
+          {
+            const float e =
+              d - tex3D<float>(Direction == 0 ? k.fixedDistances[g] : k.movingDistances[g], r[0], r[1], r[2]);
+            guidance += k.guidanceWeights[g] * (k.radius - d) * k.inverseRadius * e * e;
+          }
         }
-      }
+    }
   }
 }
 
