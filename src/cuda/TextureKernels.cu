@@ -411,19 +411,6 @@ SamplePoint(const SamplingConstants & k, const float4 * corners, bool near, cons
     r[0] = fmaf(b3, t2.y, fmaf(b2, t1.z, fmaf(b1, t0.w, t0.x)));
     r[1] = fmaf(b3, t2.z, fmaf(b2, t1.w, fmaf(b1, t1.x, t0.y)));
     r[2] = fmaf(b3, t2.w, fmaf(b2, t2.x, fmaf(b1, t1.y, t0.z)));
-#if defined(MOREA_DIAGNOSTIC_LANES)
-    {
-      // Diagnostic only (wrong values): coherent fetches. 1: lanes along x,
-      // 0.37 texel apart; 2: every lane at corner 0.
-      const float step = MOREA_DIAGNOSTIC_LANES == 1 ? 0.37f * static_cast<float>(threadIdx.x & 31) : 0.0f;
-      p[0] = f0.x + step + 1e-6f * p[0];
-      p[1] = f0.y + 1e-6f * p[1];
-      p[2] = f0.z + 1e-6f * p[2];
-      r[0] = t0.x + step + 1e-6f * r[0];
-      r[1] = t0.y + 1e-6f * r[1];
-      r[2] = t0.z + 1e-6f * r[2];
-    }
-#endif
   }
   const float a = SlicePairTrilinear(fromIntensity, Direction == 0 ? k.movingDepth : k.fixedDepth, p[0], p[1], p[2]);
   const float b = SlicePairTrilinear(toIntensity, Direction == 0 ? k.fixedDepth : k.movingDepth, r[0], r[1], r[2]);
