@@ -65,6 +65,7 @@ struct VolumeTextures
 {
   std::unique_ptr<cuda::Texture3D>                                     intensity;
   std::array<std::unique_ptr<cuda::Texture3D>, cuda::MaxTextureStructures> distances;
+  std::array<std::unique_ptr<cuda::Texture3D>, cuda::MaxTextureStructures> distancePairs;
   cuda::DeviceArray<std::uint8_t>  nearBlocks; ///< see cuda::PackedVolumeView::nearBlocks
 };
 

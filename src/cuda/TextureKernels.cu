@@ -292,7 +292,8 @@ SlicePairTrilinear(cudaTextureObject_t pairs, int depth, float x, float y, float
 struct SamplingConstants
 {
   cudaTextureObject_t movingIntensity, fixedIntensity;
-  cudaTextureObject_t movingDistances[MaxTextureStructures], fixedDistances[MaxTextureStructures];
+  cudaTextureObject_t movingDistances[MaxTextureStructures], fixedDistances[MaxTextureStructures]; ///< slice pairs
+  float               movingScales[MaxTextureStructures], fixedScales[MaxTextureStructures]; ///< mm per unit
   const std::uint8_t *movingNearBlocks, *fixedNearBlocks; ///< see PackedVolumeView::nearBlocks
   int                 movingBlocks[3], fixedBlocks[3];
   int                 movingDepth, fixedDepth; ///< slices of each image (its top layer)
@@ -436,11 +437,15 @@ SamplePoint(const SamplingConstants & k, const float4 * corners, bool near, cons
       for (int g = 0; g < MaxTextureStructures; ++g)
         if ((structures >> g) & 1u)
         {
-          const float d = tex3D<float>(Direction == 0 ? k.movingDistances[g] : k.fixedDistances[g], p[0], p[1], p[2]);
+          const float d =
+            (Direction == 0 ? k.movingScales[g] : k.fixedScales[g]) *
+            SlicePairTrilinear(Direction == 0 ? k.movingDistances[g] : k.fixedDistances[g],
+                               Direction == 0 ? k.movingDepth : k.fixedDepth, p[0], p[1], p[2]);
           if (d < k.radius)
           {
-            const float e =
-              d - tex3D<float>(Direction == 0 ? k.fixedDistances[g] : k.movingDistances[g], r[0], r[1], r[2]);
+            const float e = d - (Direction == 0 ? k.fixedScales[g] : k.movingScales[g]) *
+                                  SlicePairTrilinear(Direction == 0 ? k.fixedDistances[g] : k.movingDistances[g],
+                                                     Direction == 0 ? k.fixedDepth : k.movingDepth, r[0], r[1], r[2]);
             guidance += k.guidanceWeights[g] * (k.radius - d) * k.inverseRadius * e * e;
           }
         }
@@ -720,8 +725,10 @@ SamplingConstantsOf(const EvaluationConstants & constants)
   k.fixedIntensity = static_cast<cudaTextureObject_t>(constants.packedFixed.intensityTexture);
   for (int g = 0; g < MaxTextureStructures; ++g)
   {
-    k.movingDistances[g] = static_cast<cudaTextureObject_t>(constants.packedMoving.distanceTextures[g]);
-    k.fixedDistances[g] = static_cast<cudaTextureObject_t>(constants.packedFixed.distanceTextures[g]);
+    k.movingDistances[g] = static_cast<cudaTextureObject_t>(constants.packedMoving.distancePairTextures[g]);
+    k.fixedDistances[g] = static_cast<cudaTextureObject_t>(constants.packedFixed.distancePairTextures[g]);
+    k.movingScales[g] = constants.packedMoving.distanceScales[g];
+    k.fixedScales[g] = constants.packedFixed.distanceScales[g];
   }
   k.movingNearBlocks = constants.packedMoving.nearBlocks;
   k.fixedNearBlocks = constants.packedFixed.nearBlocks;
