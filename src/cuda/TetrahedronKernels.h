@@ -44,7 +44,7 @@ struct PackedVolumeView
   unsigned long long distanceTextures[MaxTextureStructures]{ 0, 0, 0 };
   /** Texture: the same distances as slice pairs of 16-bit normalised texels
    *  (SlicePairTrilinear), times distanceScales[g] in mm (the largest
-   *  distance: steps of 0.003 mm for the paper's abdomen pair): what the
+   *  distance, so steps of 1/65535 of it): what the
    *  sampling kernel reads, in one filtering pass at the layer it already
    *  found for the intensity, where a float 3D texture took two. On an
    *  H100, early generations' kernels served 9.77e10 samples per second
