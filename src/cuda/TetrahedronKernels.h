@@ -213,8 +213,8 @@ LaunchEvaluateTetrahedra(const EvaluationConstants & constants, const double * c
  *  throughput in two steps around one synchronisation. Step 1, one thread
  *  per tetrahedron: seeds, sample counts, corners in texel coordinates,
  *  per-item values (`itemOut`) and the split of every direction's samples
- *  into chunks of `chunkSamples`; the number of chunks goes to
- *  `totalChunks` (pinned host memory) once the stream gets there. Step 2,
+ *  into chunks of `chunkSamples`; CopyTextureChunkCount copies the number
+ *  of chunks to the host. Step 2,
  *  one warp per chunk in single precision, then the chunks' sums in a fixed
  *  order (deterministic): `directionOut`. Large and small tetrahedra thus
  *  load the GPU evenly. */
@@ -229,8 +229,15 @@ TextureChunkWorkspaceBytes(std::size_t chunks);
 /** Step 1; an item is sampled as its `itemSkip` byte says (null: all). */
 void
 LaunchPrepareTexture(const EvaluationConstants & constants, const double * corners, const std::uint32_t * tetrahedra,
-                     const std::uint8_t * itemSkip, std::size_t items, void * workspace, double * itemOut, std::uint32_t * totalChunks,
+                     const std::uint8_t * itemSkip, std::size_t items, void * workspace, double * itemOut,
                      void * stream);
+
+/** Queues the copy of the number of chunks step 1 found for `items` into
+ *  `totalChunks` (pinned host memory) on `stream`, which must be ordered
+ *  after step 1. Any stream: on the one that runs step 2, the copy waited
+ *  behind other streams' transfers from the device, and step 2 with it. */
+void
+CopyTextureChunkCount(std::size_t items, const void * workspace, std::uint32_t * totalChunks, void * stream);
 
 /** Step 2 for at most `chunkCapacity` chunks (`chunkWorkspace` sized for
  *  them): the number step 1 found is read on the device, so that the host

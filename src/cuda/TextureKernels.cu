@@ -791,7 +791,7 @@ TextureChunkWorkspaceBytes(std::size_t chunks)
 
 void
 LaunchPrepareTexture(const EvaluationConstants & constants, const double * corners, const std::uint32_t * tetrahedra,
-                     const std::uint8_t * itemSkip, std::size_t items, void * workspace, double * itemOut, std::uint32_t * totalChunks,
+                     const std::uint8_t * itemSkip, std::size_t items, void * workspace, double * itemOut,
                      void * stream)
 {
   if (items == 0)
@@ -820,7 +820,16 @@ LaunchPrepareTexture(const EvaluationConstants & constants, const double * corne
   bytes = w.scratchBytes;
   Check(cub::DeviceScan::InclusiveSum(w.scratch, bytes, w.scheduleCounts, w.scheduleEnds, static_cast<int>(tasks), s),
         "scanning the chunk counts");
-  Check(cudaMemcpyAsync(totalChunks, w.scheduleEnds + tasks - 1, sizeof(std::uint32_t), cudaMemcpyDeviceToHost, s),
+}
+
+void
+CopyTextureChunkCount(std::size_t items, const void * workspace, std::uint32_t * totalChunks, void * stream)
+{
+  if (items == 0)
+    return;
+  const PrepareWorkspace w = Partition(const_cast<void *>(workspace), items);
+  Check(cudaMemcpyAsync(totalChunks, w.scheduleEnds + 2 * items - 1, sizeof(std::uint32_t), cudaMemcpyDeviceToHost,
+                        static_cast<cudaStream_t>(stream)),
         "copying the number of chunks");
 }
 
