@@ -313,7 +313,10 @@ CudaEvaluationBackend::Deliver(const std::vector<PartialCandidate> & candidates,
     CompleteOverflowingPart(f, p, first);
     // Read before ready() may start the next batch on the previous flight.
     if (p == 0 && f.items > 0 && m_PreviousFlight)
+    {
       m_Statistics.devicePhases.betweenBatches += ElapsedSeconds(m_PreviousFlight->end, f.start);
+      RebaseFallbackIntervals(f);
+    }
     const auto unpack = std::chrono::steady_clock::now();
     ReadFoldChecks(candidates, h, f, p);
     const std::size_t begin = f.candidateBounds[p], end = f.candidateBounds[p + 1];
@@ -340,20 +343,57 @@ CudaEvaluationBackend::Deliver(const std::vector<PartialCandidate> & candidates,
 }
 
 void
+CudaEvaluationBackend::RebaseFallbackIntervals(const BatchFlight & f)
+{
+  if (m_FallbackIntervals.empty() || m_FallbackFlight == &f)
+    return;
+  if (m_FallbackFlight != m_PreviousFlight) // its start may be another batch's by now
+  {
+    m_FallbackIntervals.clear();
+    m_FallbackFlight = nullptr;
+    return;
+  }
+  const double shift = ElapsedSeconds(m_FallbackFlight->start, f.start);
+  for (auto & interval : m_FallbackIntervals)
+  {
+    interval.first -= shift;
+    interval.second -= shift;
+  }
+  m_FallbackFlight = &f;
+}
+
+void
 CudaEvaluationBackend::AddKernelSeconds(const BatchFlight & f)
 {
+  // Each span as seconds after the flight's start. The parts' spans follow
+  // one another on one stream, the fallback's on another: the overlap of
+  // the two unions is the sum of the pairwise overlaps.
+  const bool overlaps = m_FallbackFlight == &f && !m_FallbackIntervals.empty();
+  double     last = 0.0, overlap = 0.0;
+  const auto add = [&](BatchFlight::PartStep from, BatchFlight::PartStep to, std::size_t p) {
+    const double span = ElapsedSeconds(f.PartEvent(p, from), f.PartEvent(p, to));
+    m_Statistics.kernelSeconds += span;
+    if (overlaps) // (a whole evaluation's flight has no start event)
+    {
+      const double a = ElapsedSeconds(f.start.Get(), f.PartEvent(p, from)), b = a + span;
+      for (const auto & interval : m_FallbackIntervals)
+        overlap += std::max(0.0, std::min(b, interval.second) - std::max(a, interval.first));
+      last = std::max(last, b);
+    }
+    return span;
+  };
   for (std::size_t p = 0; p < f.Parts(); ++p)
   {
     if (UsesTexturePath())
-    {
-      const double setUp =
-        ElapsedSeconds(f.PartEvent(p, BatchFlight::SetUpStart), f.PartEvent(p, BatchFlight::SetUpEnd));
-      m_Statistics.kernelSeconds += setUp;
-      m_Statistics.setUpKernelSeconds += setUp;
-    }
-    m_Statistics.kernelSeconds +=
-      ElapsedSeconds(f.PartEvent(p, BatchFlight::SamplingStart), f.PartEvent(p, BatchFlight::SamplingEnd));
+      m_Statistics.setUpKernelSeconds += add(BatchFlight::SetUpStart, BatchFlight::SetUpEnd, p);
+    add(BatchFlight::SamplingStart, BatchFlight::SamplingEnd, p);
   }
+  m_Statistics.kernelSeconds -= overlap;
+  // Spans that end after this flight's sampling may overlap the next one's.
+  if (overlaps)
+    m_FallbackIntervals.erase(std::remove_if(m_FallbackIntervals.begin(), m_FallbackIntervals.end(),
+                                             [last](const auto & interval) { return interval.second <= last; }),
+                              m_FallbackIntervals.end());
 }
 
 std::uint64_t

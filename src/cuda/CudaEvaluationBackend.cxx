@@ -341,8 +341,16 @@ CudaEvaluationBackend::SampleSkipped(const std::vector<PartialCandidate> & candi
           "copying values from the device");
     Check(cudaStreamSynchronize(stream), "sampling skipped candidates");
   }
-  // Their samples count in `samples`, so their kernel's time counts too.
+  // Their samples count in `samples`, so their kernel's time counts too;
+  // the part of it the batches' sampling covers is taken off again once
+  // that is counted (AddKernelSeconds).
   m_Statistics.kernelSeconds += ElapsedSeconds(*m_FallbackStart, *m_FallbackEnd);
+  if (m_FallbackFlight != &f)
+  {
+    m_FallbackIntervals.clear();
+    m_FallbackFlight = &f;
+  }
+  m_FallbackIntervals.emplace_back(ElapsedSeconds(f.start, *m_FallbackStart), ElapsedSeconds(f.start, *m_FallbackEnd));
   // Intensity and guidance as Unpack() adds them; the rest is the bound's
   // (the batch's values of the candidate); then the sum of them all.
   std::size_t at = 0;

@@ -583,8 +583,16 @@ private:
   Deliver(const std::vector<PartialCandidate> & candidates, const HostCandidates & h, BatchFlight & f,
           const ReadyCandidates & ready);
 
+  /** Adds the device time of flight `f`'s set-up and sampling kernels,
+   *  less what the skipped candidates' sampling (on its own stream, counted
+   *  as it ran) overlapped of it: time in which both ran counts once. */
   void
   AddKernelSeconds(const BatchFlight & f);
+
+  /** Re-bases the skipped candidates' sampling intervals on flight `f`'s
+   *  start while the previous flight's start still holds (see Deliver). */
+  void
+  RebaseFallbackIntervals(const BatchFlight & f);
 
   /** Evaluates `items` items of whole solutions, their corners in flight
    *  `f` already, in one part, and waits for their values. */
@@ -665,6 +673,10 @@ private:
   // optimiser needs after all.
   std::unique_ptr<cuda::Stream>                m_FallbackStream;
   std::unique_ptr<cuda::Event>                 m_FallbackStart, m_FallbackEnd; ///< around its kernels
+  /** Its kernels' spans in seconds after m_FallbackFlight's start, kept
+   *  until the sampling they may overlap is counted (AddKernelSeconds). */
+  std::vector<std::pair<double, double>>       m_FallbackIntervals;
+  const BatchFlight *                          m_FallbackFlight{ nullptr };
   cuda::PinnedArray<std::uint64_t>             m_HostFallbackItems;
   cuda::DeviceArray<std::uint64_t>             m_FallbackItems;
   cuda::DeviceArray<double> m_FallbackCorners, m_FallbackItemValues, m_FallbackDirectionValues;
