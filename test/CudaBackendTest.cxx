@@ -959,6 +959,7 @@ TEST(CudaEvaluationBackend, CandidatesStartedEarlyGetTheValuesOfAWholeBatch)
   EXPECT_GT(skipped.size(), next.candidates.size() / 2);
   EXPECT_GT(witnessed, skipped.size() / 2) << "the entry that refused them";
   EXPECT_EQ(early->Statistics().boundSampledLater, skipped.size());
+  EXPECT_GT(early->Statistics().boundSampledLaterSamples, 0.0);
   late->EvaluatePartials(whole.candidates);
   EXPECT_EQ(late->Statistics().startedCandidates, 0u);
   std::size_t folded = 0;

@@ -167,9 +167,12 @@ TEST(RefusalBound, CpuBackendSkipsRefusedCandidatesAndSamplesThemLaterAlike)
   }
   ASSERT_FALSE(skipped.empty());
   EXPECT_GT(backend->Statistics().boundSkippedSamples, 0.0);
+  const double spared = backend->Statistics().boundSkippedSamples;
+  EXPECT_EQ(backend->Statistics().boundSampledLaterSamples, 0.0);
   backend->SampleSkipped(batch, skipped);
   EXPECT_EQ(backend->Statistics().boundSampledLater, skipped.size());
   EXPECT_EQ(backend->Statistics().boundSkippedSamples, 0.0);
+  EXPECT_EQ(backend->Statistics().boundSampledLaterSamples, spared) << "the samples the bound had spared";
   for (std::size_t i : skipped)
   {
     EXPECT_FALSE(bounds[i].skipped);

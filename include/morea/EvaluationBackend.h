@@ -132,6 +132,7 @@ struct BackendStatistics
   std::uint64_t boundSkipped{ 0 };
   double        boundSkippedSamples{ 0.0 };
   std::uint64_t boundSampledLater{ 0 };
+  double        boundSampledLaterSamples{ 0.0 }; ///< their samples (in `samples`)
   std::uint64_t boundSampleLaterCalls{ 0 }; ///< SampleSkipped calls
   double        boundSampleLaterSeconds{ 0.0 }; ///< wall time inside them
   /** CUDA only: where the device time of the EvaluatePartials batches goes,

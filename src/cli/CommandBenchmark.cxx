@@ -145,6 +145,8 @@ TimeBackend(const std::string & name, const itk::morea::MeshModel & model, const
                       { "refusal_bounds", gomea.boundRefusals },
                       { "draw_ahead_threads", optimiser.DrawAheadThreads() },
                       { "bound_skipped_samples", total.boundSkippedSamples - afterInit.boundSkippedSamples },
+                      { "samples_sampled_later",
+                        total.boundSampledLaterSamples - afterInit.boundSampledLaterSamples },
                       { "threads", threads ? threads : std::max(1u, std::thread::hardware_concurrency()) },
                       { "first_generation", firstGeneration },
                       { "seconds_initial_population", secondsPopulation },

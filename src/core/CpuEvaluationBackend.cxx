@@ -228,6 +228,7 @@ public:
       for (std::size_t k = 0; k < c.element->dependentTetrahedra.size(); ++k)
         samples += c.values[k].samples;
       m_Statistics.samples += samples;
+      m_Statistics.boundSampledLaterSamples += samples;
       m_Statistics.boundSkippedSamples -= samples;
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -151,6 +151,8 @@ CudaEvaluationBackend::ReservePart(BatchFlight & f, std::size_t p)
   }
   if (f.chunkCapacity.size() < p + 1)
     f.chunkCapacity.resize(p + 1, 0);
+  if (f.refusalOnDevice.size() < p + 1)
+    f.refusalOnDevice.resize(p + 1, 0);
 }
 
 void
@@ -214,6 +216,12 @@ CudaEvaluationBackend::SamplePart(BatchFlight & f, std::size_t p)
   // with it: 57 ms in 20 early generations on an H100.
   if (UsesTexturePath())
     cuda::CopyTextureChunkCount(count, f.workspaces[p]->Data(), f.hostChunks.Data() + p, copies);
+  // Read with the sums too (Deliver); on the sampling stream the copy
+  // stalled it the same way.
+  if (f.refusalOnDevice[p] && endCandidate > firstCandidate)
+    Check(cudaMemcpyAsync(f.hostRefusal.Data() + firstCandidate, f.refusal.Data() + firstCandidate,
+                          (endCandidate - firstCandidate) * sizeof(std::uint32_t), cudaMemcpyDeviceToHost, copies),
+          "copying the refusal screen from the device");
   if (f.skipItems && endCandidate > firstCandidate)
     Check(cudaMemcpyAsync(f.hostCandidateSums.Data() + firstCandidate * cuda::CandidateSumValues,
                           f.candidateSums.Data() + firstCandidate * cuda::CandidateSumValues,

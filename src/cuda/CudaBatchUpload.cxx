@@ -10,12 +10,12 @@ namespace morea
 {
 namespace cudabackend
 {
-void
+bool
 CudaEvaluationBackend::ScreenRange(const std::vector<PartialCandidate> & candidates, BatchFlight & f,
                                    const cuda::CandidateBatch & range)
 {
   if (!f.hasScreen)
-    return;
+    return false;
   const std::size_t begin = range.firstCandidate, end = range.candidates;
   // The bounds are filled here, while the device checks folds.
   std::atomic<bool> any{ false };
@@ -44,7 +44,7 @@ CudaEvaluationBackend::ScreenRange(const std::vector<PartialCandidate> & candida
   if (!any.load())
   {
     std::fill(f.hostRefusal.Data() + begin, f.hostRefusal.Data() + end, 0u);
-    return;
+    return false;
   }
   cudaStream_t stream = m_Stream->Get();
   const std::vector<ObjectiveVector> & archive = f.screen.archive;
@@ -68,10 +68,8 @@ CudaEvaluationBackend::ScreenRange(const std::vector<PartialCandidate> & candida
   view.foldOffset = FoldConstraintOffset;
   cuda::LaunchScreenCandidates(m_Constants, range, f.corners.Data(), f.tetrahedra.Data(), view, f.itemSkip.Data(),
                                f.refusal.Data(), stream);
-  Check(cudaMemcpyAsync(f.hostRefusal.Data() + begin, f.refusal.Data() + begin, (end - begin) * sizeof(std::uint32_t),
-                        cudaMemcpyDeviceToHost, stream),
-        "copying the refusal screen from the device");
   f.screened = true;
+  return true;
 }
 
 cuda::VolumeView
@@ -521,6 +519,7 @@ CudaEvaluationBackend::QueueRange(const std::vector<PartialCandidate> & candidat
     if (f.checks)
       Check(cudaStreamWaitEvent(stream, f.PartEvent(p, BatchFlight::FoldEnd), 0),
             "ordering corners after fold checks");
+    f.refusalOnDevice[p] = 0;
     if (f.items > 0)
     {
       cuda::CandidateBatch part = m_Batch;
@@ -528,7 +527,7 @@ CudaEvaluationBackend::QueueRange(const std::vector<PartialCandidate> & candidat
       part.candidates = f.candidateBounds[p + 1];
       cuda::LaunchGatherCandidateCorners(part, f.items, skip, f.corners.Data(), f.tetrahedra.Data(),
                                          f.itemSkip.Data(), stream);
-      ScreenRange(candidates, f, part);
+      f.refusalOnDevice[p] = ScreenRange(candidates, f, part) ? 1 : 0;
     }
     PreparePart(f, p);
     SamplePart(f, p);

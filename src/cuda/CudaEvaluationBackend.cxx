@@ -371,6 +371,7 @@ CudaEvaluationBackend::SampleSkipped(const std::vector<PartialCandidate> & candi
     c.bound->skipped = false;
     ++m_Statistics.boundSampledLater;
     m_Statistics.samples += samples;
+    m_Statistics.boundSampledLaterSamples += samples;
     m_Statistics.boundSkippedSamples -= samples;
   }
   m_Statistics.seconds += SecondsSince(start);

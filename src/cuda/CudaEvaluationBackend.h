@@ -173,6 +173,7 @@ struct BatchFlight
   cuda::DeviceArray<double>                    archive;
   cuda::DeviceArray<std::uint32_t>             refusal; ///< see cuda::LaunchScreenCandidates
   cuda::PinnedArray<std::uint32_t>             hostRefusal;
+  std::vector<std::uint8_t> refusalOnDevice; ///< per part: its screen ran on the device (its outcome to copy)
 
   std::size_t items{ 0 };
   bool        checks{ false }; ///< the fold kernel runs
@@ -309,9 +310,10 @@ public:
 private:
   /** Queues the refusal screen of candidates [range.firstCandidate,
    *  range.candidates) of flight `f`, whose corners are queued, when the
-   *  batch has a screen; its outcome reaches f.hostRefusal before the
-   *  range's first part's values. */
-  void
+   *  batch has a screen. True when it queued a kernel, whose outcome
+   *  SamplePart copies to f.hostRefusal with the part's sums; otherwise
+   *  the outcome is on the host already. */
+  bool
   ScreenRange(const std::vector<PartialCandidate> & candidates, BatchFlight & f, const cuda::CandidateBatch & range);
 
   /** Left folded by the checks and needing no values: not sampled. */
