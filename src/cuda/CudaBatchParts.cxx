@@ -164,11 +164,60 @@ CudaEvaluationBackend::PreparePart(BatchFlight & f, std::size_t p)
   cudaStream_t      stream = m_Stream->Get();
   const std::size_t begin = f.itemBounds[p], count = f.itemBounds[p + 1] - begin;
   f.workspaces[p]->Reserve(std::max<std::size_t>(1, cuda::TexturePrepareWorkspaceBytes(count)));
+  cuda::ItemSchedule schedule;
+  if (f.scheduled)
+  {
+    schedule.slots = f.schedule.Data();
+    schedule.candidateFirstItem = m_Batch.candidateFirstItem;
+    schedule.firstCandidate = f.candidateBounds[p];
+    schedule.endCandidate = f.candidateBounds[p + 1];
+    schedule.partFirstItem = begin;
+  }
   Check(cudaEventRecord(f.PartEvent(p, BatchFlight::SetUpStart), stream), "recording an event");
   cuda::LaunchPrepareTexture(m_Constants, f.corners.Data() + begin * cuda::ItemCorners, f.tetrahedra.Data() + begin,
-                             f.skipItems ? f.itemSkip.Data() + begin : nullptr, count, f.workspaces[p]->Data(),
-                             f.itemValues.Data() + begin * cuda::ItemValues, stream);
+                             f.skipItems ? f.itemSkip.Data() + begin : nullptr, count, schedule,
+                             f.workspaces[p]->Data(), f.itemValues.Data() + begin * cuda::ItemValues, stream);
   Check(cudaEventRecord(f.PartEvent(p, BatchFlight::SetUpEnd), stream), "recording an event");
+}
+
+void
+CudaEvaluationBackend::ScheduleItems(const HostCandidates & h, BatchFlight & f, std::size_t p)
+{
+  // Each element's tetrahedra in turn, all of the part's candidates of
+  // that element at one tetrahedron together: the order a stable sort by
+  // tetrahedron gives where no tetrahedron depends on two of the part's
+  // elements (a parallel group's), so that the warps running at one time
+  // read the same places of both images (see PrepareWorkspace).
+  const std::size_t begin = f.candidateBounds[p], end = f.candidateBounds[p + 1];
+  m_ScheduleGroup.assign(h.pointOffsets.size() - 1, ~std::uint32_t{ 0 }); // per element slot
+  m_ScheduleGroups.clear();
+  for (std::size_t c = begin; c < end; ++c)
+  {
+    std::uint32_t & group = m_ScheduleGroup[h.candidateElement[c]];
+    if (group == ~std::uint32_t{ 0 })
+    {
+      group = static_cast<std::uint32_t>(m_ScheduleGroups.size());
+      m_ScheduleGroups.push_back({ 0, static_cast<std::uint32_t>(h.firstItem[c + 1] - h.firstItem[c]), 0 });
+    }
+    ++m_ScheduleGroups[group].candidates;
+  }
+  std::uint32_t place = 0;
+  for (ScheduleGroup & g : m_ScheduleGroups)
+  {
+    g.next = place;
+    place += g.candidates * g.items;
+  }
+  std::uint32_t * out = f.hostSchedule.Data();
+  for (std::size_t c = begin; c < end; ++c)
+  {
+    ScheduleGroup & g = m_ScheduleGroups[m_ScheduleGroup[h.candidateElement[c]]];
+    out[2 * c] = g.next++;
+    out[2 * c + 1] = g.candidates;
+  }
+  if (end > begin)
+    Check(cudaMemcpyAsync(f.schedule.Data() + 2 * begin, out + 2 * begin, 2 * (end - begin) * sizeof(std::uint32_t),
+                          cudaMemcpyHostToDevice, m_Stream->Get()),
+          "copying the sampling order to the device");
 }
 
 void

@@ -446,6 +446,12 @@ CudaEvaluationBackend::BeginFlight(const std::vector<PartialCandidate> & candida
   f.hostCandidateSums.Reserve(std::max<std::size_t>(1, n) * cuda::CandidateSumValues);
   f.valuesWritten.assign(n, 0);
   f.partsWithValues = 0;
+  f.scheduled = UsesTexturePath() && f.items > 0;
+  if (f.scheduled)
+  {
+    f.hostSchedule.Reserve(2 * n);
+    f.schedule.Reserve(2 * n);
+  }
   if (f.checks)
   {
     f.outcome.Reserve(2 * n);
@@ -529,6 +535,8 @@ CudaEvaluationBackend::QueueRange(const std::vector<PartialCandidate> & candidat
                                          f.itemSkip.Data(), stream);
       f.refusalOnDevice[p] = ScreenRange(candidates, f, part) ? 1 : 0;
     }
+    if (f.scheduled)
+      ScheduleItems(h, f, p);
     PreparePart(f, p);
     SamplePart(f, p);
   }

@@ -383,6 +383,7 @@ void
 CudaEvaluationBackend::RunWhole(BatchFlight & f, std::size_t items)
 {
   f.skipItems = false;
+  f.scheduled = false; // whole solutions' items: sorted by tetrahedron
   f.items = items;
   f.ranges = 0;
   f.candidateBounds.assign({ 0, 0 });

@@ -160,6 +160,12 @@ struct BatchFlight
   cuda::DeviceArray<std::uint8_t>  outcome; ///< per candidate side: the fold checks' outcome
   cuda::PinnedArray<std::uint8_t>  hostOutcome;
   cuda::PinnedArray<std::uint32_t> hostChunks; ///< per part: the texture set-up's number of chunks
+  /** Per candidate the first place and stride of its items in its part's
+   *  sampling order (cuda::ItemSchedule); `scheduled`: they are set (a
+   *  whole evaluation's items are sorted instead). */
+  cuda::PinnedArray<std::uint32_t> hostSchedule;
+  cuda::DeviceArray<std::uint32_t> schedule;
+  bool                             scheduled{ false };
   std::vector<std::unique_ptr<cuda::DeviceArray<unsigned char>>> workspaces, chunkWorkspaces; ///< per part
 
   /** The refusal screen of the whole batch, as it was when the batch began. */
@@ -544,6 +550,11 @@ private:
   void
   ReservePart(BatchFlight & f, std::size_t p);
 
+  /** On the texture path, the order of part `p`'s items in its sampling
+   *  (cuda::ItemSchedule) from the candidates' layout, queued to the device. */
+  void
+  ScheduleItems(const HostCandidates & h, BatchFlight & f, std::size_t p);
+
   /** On the texture path, the sampling set-up of part `p` (reserved). */
   void
   PreparePart(BatchFlight & f, std::size_t p);
@@ -679,6 +690,14 @@ private:
    *  until the sampling they may overlap is counted (AddKernelSeconds). */
   std::vector<std::pair<double, double>>       m_FallbackIntervals;
   const BatchFlight *                          m_FallbackFlight{ nullptr };
+  /** ScheduleItems' scratch: per element slot its group in the part, and
+   *  per group its candidates, their items each and the next free place. */
+  struct ScheduleGroup
+  {
+    std::uint32_t candidates, items, next;
+  };
+  std::vector<std::uint32_t> m_ScheduleGroup;
+  std::vector<ScheduleGroup> m_ScheduleGroups;
   cuda::PinnedArray<std::uint64_t>             m_HostFallbackItems;
   cuda::DeviceArray<std::uint64_t>             m_FallbackItems;
   cuda::DeviceArray<double> m_FallbackCorners, m_FallbackItemValues, m_FallbackDirectionValues;

@@ -226,11 +226,25 @@ TexturePrepareWorkspaceBytes(std::size_t items);
 std::size_t
 TextureChunkWorkspaceBytes(std::size_t chunks);
 
+/** The order in which step 2 takes a part's items, where the batch's
+ *  layout gives it: item j of candidate c (c in [firstCandidate,
+ *  endCandidate), its items from candidateFirstItem[c] - partFirstItem)
+ *  goes to place slots[2 c] + j slots[2 c + 1]. Null `slots`: step 1 sorts
+ *  the items by tetrahedron instead (stable). */
+struct ItemSchedule
+{
+  const std::uint32_t * slots{ nullptr };
+  const std::uint64_t * candidateFirstItem{ nullptr }; ///< per candidate, plus one
+  std::size_t           firstCandidate{ 0 };
+  std::size_t           endCandidate{ 0 };
+  std::uint64_t         partFirstItem{ 0 };
+};
+
 /** Step 1; an item is sampled as its `itemSkip` byte says (null: all). */
 void
 LaunchPrepareTexture(const EvaluationConstants & constants, const double * corners, const std::uint32_t * tetrahedra,
-                     const std::uint8_t * itemSkip, std::size_t items, void * workspace, double * itemOut,
-                     void * stream);
+                     const std::uint8_t * itemSkip, std::size_t items, const ItemSchedule & schedule,
+                     void * workspace, double * itemOut, void * stream);
 
 /** Queues the copy of the number of chunks step 1 found for `items` into
  *  `totalChunks` (pinned host memory) on `stream`, which must be ordered

@@ -303,6 +303,23 @@ struct SamplingConstants
   std::uint32_t       chunkIterations; ///< 32 samples each
 };
 
+/** Items in the order an ItemSchedule gives, one thread per candidate: in
+ *  place of the sort by tetrahedron (four memory sets and four kernels,
+ *  about 35 us per part of a paper-scale batch on an H100). */
+__global__ void
+ScheduleCandidateItems(ItemSchedule schedule, std::uint32_t * sortedItems)
+{
+  const std::size_t c = schedule.firstCandidate + static_cast<std::size_t>(blockIdx.x) * blockDim.x + threadIdx.x;
+  if (c >= schedule.endCandidate)
+    return;
+  const uint2         slot = reinterpret_cast<const uint2 *>(schedule.slots)[c]; // first place, stride
+  const std::uint64_t first = schedule.candidateFirstItem[c];
+  const auto          n = static_cast<std::uint32_t>(schedule.candidateFirstItem[c + 1] - first);
+  const auto          item = static_cast<std::uint32_t>(first - schedule.partFirstItem);
+  for (std::uint32_t j = 0; j < n; ++j)
+    sortedItems[slot.x + j * slot.y] = item + j;
+}
+
 /** The task at schedule position `position`. */
 __device__ std::uint32_t
 ScheduledTask(const std::uint32_t * __restrict__ sortedItems, std::size_t position)
@@ -791,8 +808,8 @@ TextureChunkWorkspaceBytes(std::size_t chunks)
 
 void
 LaunchPrepareTexture(const EvaluationConstants & constants, const double * corners, const std::uint32_t * tetrahedra,
-                     const std::uint8_t * itemSkip, std::size_t items, void * workspace, double * itemOut,
-                     void * stream)
+                     const std::uint8_t * itemSkip, std::size_t items, const ItemSchedule & schedule,
+                     void * workspace, double * itemOut, void * stream)
 {
   if (items == 0)
     return;
@@ -804,15 +821,24 @@ LaunchPrepareTexture(const EvaluationConstants & constants, const double * corne
   PrepareTextureTasks<<<blocks, PrepareThreads, 0, s>>>(constants, corners, tetrahedra, itemSkip, items, w.tasks,
                                                         w.chunkCounts, w.itemIndex, itemOut);
   Check(cudaGetLastError(), "launching the texture set-up kernel");
-  // Only the bits a tetrahedron index can have: 2 passes instead of 4 for
-  // a few thousand tetrahedra (ScratchBytes sized the sort for all 32).
-  int keyBits = constants.tetrahedra == 0 ? 32 : 1; // 0: not known
-  while (keyBits < 32 && (std::uint64_t{ 1 } << keyBits) < constants.tetrahedra)
-    ++keyBits;
   std::size_t bytes = w.scratchBytes;
-  Check(cub::DeviceRadixSort::SortPairs(w.scratch, bytes, tetrahedra, w.sortedKeys, w.itemIndex, w.sortedItems,
-                                        static_cast<int>(items), 0, keyBits, s),
-        "sorting the schedule by tetrahedron");
+  if (schedule.slots != nullptr)
+  {
+    const std::size_t candidates = schedule.endCandidate - schedule.firstCandidate;
+    ScheduleCandidateItems<<<static_cast<unsigned>((candidates + 127) / 128), 128, 0, s>>>(schedule, w.sortedItems);
+    Check(cudaGetLastError(), "launching the schedule of candidates' items");
+  }
+  else
+  {
+    // Only the bits a tetrahedron index can have: 2 passes instead of 4
+    // for a few thousand tetrahedra (ScratchBytes sized the sort for 32).
+    int keyBits = constants.tetrahedra == 0 ? 32 : 1; // 0: not known
+    while (keyBits < 32 && (std::uint64_t{ 1 } << keyBits) < constants.tetrahedra)
+      ++keyBits;
+    Check(cub::DeviceRadixSort::SortPairs(w.scratch, bytes, tetrahedra, w.sortedKeys, w.itemIndex, w.sortedItems,
+                                          static_cast<int>(items), 0, keyBits, s),
+          "sorting the schedule by tetrahedron");
+  }
   const std::size_t tasks = 2 * items;
   const unsigned    taskBlocks = static_cast<unsigned>((tasks + 255) / 256);
   GatherScheduleCounts<<<taskBlocks, 256, 0, s>>>(w.sortedItems, w.chunkCounts, tasks, w.scheduleCounts);
