@@ -71,11 +71,12 @@ constexpr int           SampleWarpsPerBlock = 8;
 
 /** Step 1's workspace, 256-byte aligned parts. Tasks are numbered 2 item +
  *  direction; the schedule is the order in which warps take their chunks:
- *  tasks sorted by tetrahedron (stable), so that the warps running at one
- *  time sample the same tetrahedron of many solutions of the batch, which
- *  lies in about the same place of both images, and find its texels in the
- *  caches. On an H100 this took the L1 hit rate from 52 to 65 % and the
- *  kernel time down by a quarter (L2 throughput had been the limit). */
+ *  tasks grouped by tetrahedron (an ItemSchedule, or a stable sort), so
+ *  that the warps running at one time sample the same tetrahedron of many
+ *  solutions of the batch, which lies in about the same place of both
+ *  images, and find its texels in the caches. On an H100 this took the L1
+ *  hit rate from 52 to 65 % and the kernel time down by a quarter (L2
+ *  throughput had been the limit). */
 struct PrepareWorkspace
 {
   SampleTask *    tasks;
