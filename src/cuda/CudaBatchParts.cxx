@@ -189,11 +189,11 @@ CudaEvaluationBackend::ScheduleItems(const HostCandidates & h, BatchFlight & f, 
   // elements (a parallel group's), so that the warps running at one time
   // read the same places of both images (see PrepareWorkspace).
   const std::size_t begin = f.candidateBounds[p], end = f.candidateBounds[p + 1];
-  m_ScheduleGroup.assign(h.pointOffsets.size() - 1, ~std::uint32_t{ 0 }); // per element slot
+  m_SlotGroup.assign(h.pointOffsets.size() - 1, ~std::uint32_t{ 0 }); // per element slot
   m_ScheduleGroups.clear();
   for (std::size_t c = begin; c < end; ++c)
   {
-    std::uint32_t & group = m_ScheduleGroup[h.candidateElement[c]];
+    std::uint32_t & group = m_SlotGroup[h.candidateElement[c]];
     if (group == ~std::uint32_t{ 0 })
     {
       group = static_cast<std::uint32_t>(m_ScheduleGroups.size());
@@ -210,7 +210,7 @@ CudaEvaluationBackend::ScheduleItems(const HostCandidates & h, BatchFlight & f, 
   std::uint32_t * out = f.hostSchedule.Data();
   for (std::size_t c = begin; c < end; ++c)
   {
-    ScheduleGroup & g = m_ScheduleGroups[m_ScheduleGroup[h.candidateElement[c]]];
+    ScheduleGroup & g = m_ScheduleGroups[m_SlotGroup[h.candidateElement[c]]];
     out[2 * c] = g.next++;
     out[2 * c + 1] = g.candidates;
   }

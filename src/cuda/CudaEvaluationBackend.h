@@ -696,7 +696,7 @@ private:
   {
     std::uint32_t candidates, items, next;
   };
-  std::vector<std::uint32_t> m_ScheduleGroup;
+  std::vector<std::uint32_t> m_SlotGroup;
   std::vector<ScheduleGroup> m_ScheduleGroups;
   cuda::PinnedArray<std::uint64_t>             m_HostFallbackItems;
   cuda::DeviceArray<std::uint64_t>             m_FallbackItems;

@@ -257,7 +257,8 @@ PrepareTextureTasks(EvaluationConstants k, const double * __restrict__ corners,
       return skip == ItemSampled ? (samples + k.chunkSamples - 1) / k.chunkSamples : 0u;
     };
     reinterpret_cast<uint2 *>(chunkCounts)[item] = make_uint2(chunksOf(forward.samples), chunksOf(backward.samples));
-    itemIndex[item] = static_cast<std::uint32_t>(item);
+    if (itemIndex != nullptr) // the sort's values, where it sorts
+      itemIndex[item] = static_cast<std::uint32_t>(item);
 
     WriteItemValues(k.referenceVolumes, k.volumeFraction, k.elasticity, tetrahedra[item], source, target,
                     itemOut + item * ItemValues);
@@ -819,32 +820,33 @@ LaunchPrepareTexture(const EvaluationConstants & constants, const double * corne
   const cudaStream_t     s = static_cast<cudaStream_t>(stream);
   const PrepareWorkspace w = Partition(workspace, items);
   const unsigned         blocks = static_cast<unsigned>((items + PrepareThreads - 1) / PrepareThreads);
+  const bool sorted = schedule.slots == nullptr;
   PrepareTextureTasks<<<blocks, PrepareThreads, 0, s>>>(constants, corners, tetrahedra, itemSkip, items, w.tasks,
-                                                        w.chunkCounts, w.itemIndex, itemOut);
+                                                        w.chunkCounts, sorted ? w.itemIndex : nullptr, itemOut);
   Check(cudaGetLastError(), "launching the texture set-up kernel");
-  std::size_t bytes = w.scratchBytes;
-  if (schedule.slots != nullptr)
-  {
-    const std::size_t candidates = schedule.endCandidate - schedule.firstCandidate;
-    ScheduleCandidateItems<<<static_cast<unsigned>((candidates + 127) / 128), 128, 0, s>>>(schedule, w.sortedItems);
-    Check(cudaGetLastError(), "launching the schedule of candidates' items");
-  }
-  else
+  if (sorted)
   {
     // Only the bits a tetrahedron index can have: 2 passes instead of 4
     // for a few thousand tetrahedra (ScratchBytes sized the sort for 32).
     int keyBits = constants.tetrahedra == 0 ? 32 : 1; // 0: not known
     while (keyBits < 32 && (std::uint64_t{ 1 } << keyBits) < constants.tetrahedra)
       ++keyBits;
+    std::size_t bytes = w.scratchBytes;
     Check(cub::DeviceRadixSort::SortPairs(w.scratch, bytes, tetrahedra, w.sortedKeys, w.itemIndex, w.sortedItems,
                                           static_cast<int>(items), 0, keyBits, s),
           "sorting the schedule by tetrahedron");
+  }
+  else
+  {
+    const std::size_t candidates = schedule.endCandidate - schedule.firstCandidate;
+    ScheduleCandidateItems<<<static_cast<unsigned>((candidates + 127) / 128), 128, 0, s>>>(schedule, w.sortedItems);
+    Check(cudaGetLastError(), "launching the schedule of candidates' items");
   }
   const std::size_t tasks = 2 * items;
   const unsigned    taskBlocks = static_cast<unsigned>((tasks + 255) / 256);
   GatherScheduleCounts<<<taskBlocks, 256, 0, s>>>(w.sortedItems, w.chunkCounts, tasks, w.scheduleCounts);
   Check(cudaGetLastError(), "launching the schedule kernel");
-  bytes = w.scratchBytes;
+  std::size_t bytes = w.scratchBytes;
   Check(cub::DeviceScan::InclusiveSum(w.scratch, bytes, w.scheduleCounts, w.scheduleEnds, static_cast<int>(tasks), s),
         "scanning the chunk counts");
 }
