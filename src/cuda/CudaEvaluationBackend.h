@@ -48,13 +48,16 @@ using cuda::Check;
 
 // A batch of partial candidates runs in parts of at least MinItemsPerPart
 // tetrahedra, at most MaxParts: the caller accepts one part while the device
-// samples the next. Smaller parts keep fewer solutions' copies of a
-// tetrahedron together in the sorted schedule: on an H100, 4 parts of the
-// paper configuration's batches made the kernels 4 % slower and each
-// generation 10 % faster (2 parts: 1.5 % and 8 %).
+// samples the next. Each part costs the device its own set-up launches and
+// the tail of its sampling kernel, where the multiprocessors run out of
+// blocks. On an H100, with the paper's configuration: against 4 parts, 3
+// sampled 1.6 % more points per second of kernels in early generations
+// (2.5 % in late ones) at the same seconds per generation; 2 parts 2.8 %
+// (3.9 %) but late generations about 3 % slower; 1 part 10 % (9.6 %) and late
+// generations 24 % slower, nothing overlapping the acceptance.
 // The last part's acceptance has nothing to overlap with, so that part is
 // smaller: LastPartShare of the others'.
-constexpr std::size_t MaxParts = 4;
+constexpr std::size_t MaxParts = 3;
 constexpr std::size_t MinItemsPerPart = 100000;
 constexpr double      LastPartShare = 0.5;
 // Room for this many times the most chunks per item seen so far.
