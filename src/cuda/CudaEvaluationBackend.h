@@ -53,8 +53,8 @@ using cuda::Check;
 // blocks. On an H100, with the paper's configuration: against 4 parts, 3
 // sampled 1.6 % more points per second of kernels in early generations
 // (2.5 % in late ones) at the same seconds per generation; 2 parts 2.8 %
-// (3.9 %) but late generations about 3 % slower; 1 part 10 % (9.6 %) and late
-// generations 24 % slower, nothing overlapping the acceptance.
+// (3.9 %) but late generations about 3 % slower; 1 part 9.6 % in late ones,
+// which took 24 % longer, nothing overlapping the acceptance.
 // The last part's acceptance has nothing to overlap with, so that part is
 // smaller: LastPartShare of the others'.
 constexpr std::size_t MaxParts = 3;
