@@ -21,7 +21,7 @@ import json
 import lzma
 import re
 
-SAMPLING = re.compile(r"PrepareTextureTasks|DeviceRadixSort|GatherScheduleCounts|DeviceScan|"
+SAMPLING = re.compile(r"PrepareTextureTasks|DeviceRadixSort|ScheduleCandidateItems|GatherScheduleCounts|DeviceScan|"
                       r"ScatterChunkTasks|SampleTextureChunks|SumChunks|SampleListedChunks")
 MAIN = re.compile(r"SampleTextureChunks")
 
