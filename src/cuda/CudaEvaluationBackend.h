@@ -51,11 +51,12 @@ using cuda::Check;
 // samples the next. Each part costs the device its own set-up launches, the
 // tail of its sampling kernel (where the multiprocessors run out of blocks),
 // and in its schedule fewer solutions' copies of a tetrahedron side by side
-// for the texture cache. On an H100, with the paper's configuration: against 4 parts, 3
-// sampled 1.6 % more points per second of kernels in early generations
-// (2.5 % in late ones) at the same seconds per generation; 2 parts 2.8 %
-// (3.9 %) but late generations about 3 % slower; 1 part 9.6 % in late ones,
-// which took 24 % longer, nothing overlapping the acceptance.
+// for the texture cache. On an H100, with the paper's configuration, against
+// 4 parts: 3 sampled 1.6 % more points per second of kernels in early
+// generations (2.5 % in late ones) at the same seconds per generation; 2
+// parts 2.8 % (3.9 %), but late generations were about 3 % slower; 1 part
+// 9.6 % in late ones, which took 24 % longer with nothing overlapping the
+// acceptance.
 // The last part's acceptance has nothing to overlap with, so that part is
 // smaller: LastPartShare of the others'.
 constexpr std::size_t MaxParts = 3;
