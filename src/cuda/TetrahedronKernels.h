@@ -214,10 +214,9 @@ LaunchEvaluateTetrahedra(const EvaluationConstants & constants, const double * c
  *  per tetrahedron: seeds, sample counts, corners in texel coordinates,
  *  per-item values (`itemOut`) and the split of every direction's samples
  *  into chunks of `chunkSamples`; CopyTextureChunkCount copies the number
- *  of chunks to the host. Step 2,
- *  one warp per chunk in single precision, then the chunks' sums in a fixed
- *  order (deterministic): `directionOut`. Large and small tetrahedra thus
- *  load the GPU evenly. */
+ *  of chunks to the host. Step 2, one warp per chunk in single precision,
+ *  then the chunks' sums in a fixed order (deterministic): `directionOut`.
+ *  Large and small tetrahedra thus load the GPU evenly. */
 /** Bytes of `workspace` step 1 needs for `items` tetrahedra. */
 std::size_t
 TexturePrepareWorkspaceBytes(std::size_t items);
