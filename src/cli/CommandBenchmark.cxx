@@ -147,6 +147,7 @@ TimeBackend(const std::string & name, const itk::morea::MeshModel & model, const
                       { "bound_skipped_samples", total.boundSkippedSamples - afterInit.boundSkippedSamples },
                       { "samples_sampled_later",
                         total.boundSampledLaterSamples - afterInit.boundSampledLaterSamples },
+                      { "parts_sampled_again", total.partsSampledAgain - afterInit.partsSampledAgain },
                       { "threads", threads ? threads : std::max(1u, std::thread::hardware_concurrency()) },
                       { "first_generation", firstGeneration },
                       { "seconds_initial_population", secondsPopulation },

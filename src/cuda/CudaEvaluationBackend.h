@@ -62,7 +62,9 @@ using cuda::Check;
 constexpr std::size_t MaxParts = 3;
 constexpr std::size_t MinItemsPerPart = 100000;
 constexpr double      LastPartShare = 0.5;
-// Room for this many times the most chunks per item seen so far.
+// Room for this many times the most chunks per item seen so far. The
+// sampling grid is sized for the room, and its blocks past the chunks leave
+// at once but still pass through the device's block scheduler.
 constexpr double ChunkRoomMargin = 1.25;
 
 /** The texture path's textures of one image. */
@@ -645,7 +647,10 @@ private:
   std::unique_ptr<cuda::Event> m_MovedCopied;
   std::unique_ptr<BatchFlight>  m_Flights[2]; ///< as m_HostCandidates: the batch in flight, the next one
   const BatchFlight *           m_PreviousFlight{ nullptr }; ///< the last batch handed over, for its end
-  double                        m_ChunksPerItem{ 6.0 }; ///< room for chunks per item: the most seen, with a margin
+  /** Room for chunks per item: a first guess, then the most seen so far
+   *  (m_MostChunksPerItem) with a margin. */
+  double                        m_ChunksPerItem{ 6.0 };
+  double                        m_MostChunksPerItem{ 0.0 };
   cuda::EvaluationConstants     m_Constants;
   cuda::DeviceArray<float>      m_Moving, m_Fixed, m_PackedMoving, m_PackedFixed;
   VolumeTextures m_MovingTextures, m_FixedTextures;

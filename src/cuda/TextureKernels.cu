@@ -147,16 +147,18 @@ WorkspaceBytes(std::size_t items)
 
 /** Texel coordinates (centres at +0.5) of corner 0, then the edges from
  *  corner 0 to corners 1-3 in texels: a sample point is then corner 0 plus
- *  three multiply-adds per axis. Clamping to the image is left to the
- *  texture's clamp addressing, which gives the edge voxel's value outside,
- *  as the exact path's clamped coordinates do. */
+ *  three multiply-adds per axis. Along z the coordinate is the slice-pair
+ *  coordinate, another half texel up (SlicePairTrilinear), so that no lane
+ *  adds it per fetch. Clamping to the image is left to the texture's clamp
+ *  addressing, which gives the edge voxel's value outside, as the exact
+ *  path's clamped coordinates do. */
 __device__ void
 TexelCorners(const PackedVolumeView & image, const double c[12], float out[12])
 {
 #pragma unroll
   for (int a = 0; a < 3; ++a)
   {
-    out[a] = static_cast<float>((c[a] - image.origin[a]) * image.inverseSpacing[a]) + 0.5f;
+    out[a] = static_cast<float>((c[a] - image.origin[a]) * image.inverseSpacing[a] + (a == 2 ? 1.0 : 0.5));
 #pragma unroll
     for (int i = 1; i < 4; ++i)
       out[3 * i + a] = static_cast<float>((c[3 * i + a] - c[a]) * image.inverseSpacing[a]);
@@ -269,25 +271,29 @@ PrepareTextureTasks(EvaluationConstants k, const double * __restrict__ corners,
     out[q] = stage.tasks[(q / (2 * TaskQuads)) * TaskStride + q % (2 * TaskQuads)];
 }
 
-/** Trilinear interpolation at texel position (x, y, z) of an intensity
- *  texture of slice pairs (layer l: slices l - 1 and l, clamped; see
- *  UploadPacked): slice k's centre lies at z = k + 1/2, so the pair around z
- *  is layer floor(z + 1/2), and z + 1/2 minus that is slice l's weight.
- *  Layers 0 and `depth` pair the edge slice with itself, which clamps as the
- *  exact path clamps. One bilinear pass of 32-bit texels instead of a 3D
- *  texture's two passes, and the weight along z in single precision rather
- *  than the texture units' 8 fraction bits. On an H100, early generations'
- *  kernels sampled 9.16e10 points per second against 9.01e10 with a 3D
- *  texture of 16-bit texels (cuda/early-h100-slice-pairs.txt); the texels
- *  read are as many bytes, so the texture units' data path still bounds it. */
+/** Trilinear interpolation at texel position (x, y) and slice-pair
+ *  coordinate s = z + 1/2 of an intensity texture of slice pairs (layer l:
+ *  slices l - 1 and l, clamped; see UploadPacked): slice k's centre lies at
+ *  z = k + 1/2, so the pair around z is layer floor(s), and s minus that is
+ *  slice l's weight. Layers 0 and `top` pair the edge slice with itself, so
+ *  outside them the weight does not matter and the layer is floor(min(s,
+ *  top)), converted to 16 bits with saturation (negatives to 0): a value
+ *  the compiler knows to fit the instruction's 16-bit layer field, so it
+ *  adds no clamp of its own (two instructions per fetch instead of six).
+ *  One bilinear pass of 32-bit texels instead of a 3D texture's two passes,
+ *  and the weight along z in single precision rather than the texture
+ *  units' 8 fraction bits. On an H100, early generations' kernels sampled
+ *  9.16e10 points per second against 9.01e10 with a 3D texture of 16-bit
+ *  texels (cuda/early-h100-slice-pairs.txt); the texels read are as many
+ *  bytes, so the texture units' data path still bounds it. */
 __device__ __forceinline__ float
-SlicePairTrilinear(cudaTextureObject_t pairs, int depth, float x, float y, float z)
+SlicePairTrilinear(cudaTextureObject_t pairs, float top, float x, float y, float s)
 {
-  const float s = z + 0.5f;
-  const float l = floorf(s);
-  const int   layer = min(max(static_cast<int>(l), 0), depth);
-  const float2 v = tex2DLayered<float2>(pairs, x, y, layer);
-  return fmaf(s - l, v.y - v.x, v.x);
+  unsigned short layer;
+  asm("cvt.rmi.sat.u16.f32 %0, %1;" : "=h"(layer) : "f"(fminf(s, top)));
+  // Level 0 named (TEX.LZ): no level-of-detail operand to set per fetch.
+  const float2 v = tex2DLayeredLod<float2>(pairs, x, y, layer, 0.0f);
+  return fmaf(s - floorf(s), v.y - v.x, v.x);
 }
 
 /** What the sampling kernel needs besides the tasks, by value. */
@@ -298,7 +304,7 @@ struct SamplingConstants
   float               movingScales[MaxTextureStructures], fixedScales[MaxTextureStructures]; ///< mm per unit
   const std::uint8_t *movingNearBlocks, *fixedNearBlocks; ///< see PackedVolumeView::nearBlocks
   int                 movingBlocks[3], fixedBlocks[3];
-  int                 movingDepth, fixedDepth; ///< slices of each image (its top layer)
+  float               movingDepth, fixedDepth; ///< slices of each image (its top layer)
   float               guidanceWeights[3];
   float               radius, inverseRadius;
   int                 structures;
@@ -356,24 +362,26 @@ ScatterChunkTasks(const std::uint32_t * __restrict__ sortedItems, const std::uin
     chunkTask[c] = task;
 }
 
-/** The structures whose distance at texel position `p` may be below the
- *  guidance radius (PackedVolumeView::nearBlocks: bit g for structure g).
- *  The block of the footprint's first texel floor(p - 1/2), clamped as the
- *  texture clamps: the rule of morea::NearContourBlocks::BlockOf, in texel
- *  coordinates. */
+/** The structures whose distance at texel position `p` (along z the
+ *  slice-pair coordinate, TexelCorners) may be below the guidance radius
+ *  (PackedVolumeView::nearBlocks: bit g for structure g). The block of the
+ *  footprint's first texel floor(p - 1/2), along z floor(s - 1), clamped as
+ *  the texture clamps: the rule of morea::NearContourBlocks::BlockOf, in
+ *  texel coordinates. */
 __device__ unsigned
 NearStructures(const std::uint8_t * __restrict__ nearBlocks, const int blocks[3], const float p[3])
 {
   // 32-bit block numbers (an image has far fewer than 2^32 blocks): the
   // 64-bit index arithmetic was about 15 instructions per sample. With a
   // power-of-two block size, p / size - 1 / (2 size) is (p - 1/2) / size
-  // exactly, in one multiply-add.
+  // exactly, in one multiply-add (along z s / size - 1 / size).
   static_assert((NearBlockSize & (NearBlockSize - 1)) == 0, "a power-of-two block size");
+  // The conversion to unsigned takes negatives to 0: one clamp per axis.
   unsigned b[3];
 #pragma unroll
   for (int a = 0; a < 3; ++a)
-    b[a] = static_cast<unsigned>(
-      min(max(__float2int_rd(fmaf(p[a], 1.0f / NearBlockSize, -0.5f / NearBlockSize)), 0), blocks[a] - 1));
+    b[a] = min(__float2uint_rd(fmaf(p[a], 1.0f / NearBlockSize, (a == 2 ? -1.0f : -0.5f) / NearBlockSize)),
+               static_cast<unsigned>(blocks[a] - 1));
   const unsigned block = (b[2] * static_cast<unsigned>(blocks[1]) + b[1]) * static_cast<unsigned>(blocks[0]) + b[0];
   return (__ldg(nearBlocks + (block >> 1)) >> (4 * (block & 1u))) & 0x0fu;
 }
@@ -412,13 +420,20 @@ SamplePoint(const SamplingConstants & k, const float4 * corners, bool near, cons
   const cudaTextureObject_t toIntensity = Direction == 0 ? k.fixedIntensity : k.movingIntensity;
   const std::uint8_t *      fromNearBlocks = Direction == 0 ? k.movingNearBlocks : k.fixedNearBlocks;
   const int *               fromBlocks = Direction == 0 ? k.movingBlocks : k.fixedBlocks;
-  float w[4];
+  // The weights are w = -log2 u = 32 - l with u = (state + 1/2) / 2^32 and
+  // l = log2(state + 1/2); their sum is 128 minus the sum of the l, and
+  // w / sum = 32 / sum - l / sum: two instructions fewer than forming each
+  // w first. (The sum loses a few more low bits of the l to cancellation,
+  // about 1e-6 of a tetrahedron's size, far below the texture units' 1/256
+  // of a texel.)
+  float l[4];
 #pragma unroll
   for (int d = 0; d < 4; ++d)
-    w[d] = 32.0f - Log2Approximate(__uint2float_rn(state[d]) + 0.5f); // -log2 u, u = (state + 1/2) / 2^32
-  const float sum = ((w[0] + w[1]) + w[2]) + w[3]; // 0 + w[0] + ... without the 0 (the weights are not -0)
-  const float inverseSum = ReciprocalApproximate(sum);
-  const float b1 = w[1] * inverseSum, b2 = w[2] * inverseSum, b3 = w[3] * inverseSum;
+    l[d] = Log2Approximate(__uint2float_rn(state[d]) + 0.5f);
+  const float inverseSum = ReciprocalApproximate(128.0f - ((l[0] + l[1]) + (l[2] + l[3])));
+  const float scaled = 32.0f * inverseSum;
+  const float b1 = fmaf(-l[1], inverseSum, scaled), b2 = fmaf(-l[2], inverseSum, scaled),
+              b3 = fmaf(-l[3], inverseSum, scaled);
   // Corners from shared memory (broadcast loads): 51 registers instead
   // of 56 with them in registers, at the same speed on an H100.
   float p[3], r[3];
@@ -645,7 +660,7 @@ SampleChunk(const SamplingConstants & k, const ChunkHeader & h, std::size_t chun
  *  chunk's header loads while the first is sampled (62 registers, 4 blocks
  *  per SM as with one chunk): on an H100, 9.09e10 samples per second against
  *  9.02e10, the same sums. */
-__global__ void __launch_bounds__(SampleWarpsPerBlock * 32, 4)
+__global__ void __launch_bounds__(SampleWarpsPerBlock * 32, 5)
 SampleTextureChunks(SamplingConstants k, const SampleTask * __restrict__ tasks,
                     const std::uint32_t * __restrict__ taskFirstChunk, const std::uint32_t * __restrict__ chunkTask,
                     const std::uint32_t * __restrict__ totalChunks, std::size_t capacity, double2 * chunkSums)
@@ -756,8 +771,8 @@ SamplingConstantsOf(const EvaluationConstants & constants)
     k.movingBlocks[a] = constants.packedMoving.blocks[a];
     k.fixedBlocks[a] = constants.packedFixed.blocks[a];
   }
-  k.movingDepth = constants.packedMoving.size[2];
-  k.fixedDepth = constants.packedFixed.size[2];
+  k.movingDepth = static_cast<float>(constants.packedMoving.size[2]);
+  k.fixedDepth = static_cast<float>(constants.packedFixed.size[2]);
   for (int g = 0; g < 3; ++g)
     k.guidanceWeights[g] = constants.textureGuidanceWeights[g];
   k.radius = static_cast<float>(constants.guidanceRadius);
