@@ -596,7 +596,7 @@ LoadChunk(const SampleTask * __restrict__ tasks, const std::uint32_t * __restric
  *    whole block, not single bits, find them (morea/SampleCosets.h). */
 __device__ void
 SampleChunk(const SamplingConstants & k, const ChunkHeader & h, std::size_t chunk, int lane, const float4 * corners,
-            double2 * chunkSums)
+            double2 * chunkSums, double * directionOut)
 {
   const int           direction = static_cast<int>(h.task & 1u);
   std::uint32_t       j = h.local * k.chunkIterations;
@@ -651,7 +651,18 @@ SampleChunk(const SamplingConstants & k, const ChunkHeader & h, std::size_t chun
     SampleRows<1>(k, corners, j, h.n, h.near, lane, state, intensity, guidance);
   const double intensitySum = WarpSum(static_cast<double>(intensity));
   const double guidanceSum = WarpSum(static_cast<double>(guidance));
-  if (lane == 0)
+  if (lane != 0)
+    return;
+  // A task's only chunk holds its values (0 + x is x): SumChunks then
+  // passes over most tasks without reading their chunk sums and counts.
+  if (directionOut != nullptr && h.n <= 32 * k.chunkIterations)
+  {
+    double * out = directionOut + static_cast<std::size_t>(h.task) * DirectionValues;
+    out[0] = intensitySum;
+    out[1] = guidanceSum;
+    out[2] = static_cast<double>(h.n);
+  }
+  else
     chunkSums[chunk] = make_double2(intensitySum, guidanceSum);
 }
 
@@ -663,7 +674,8 @@ SampleChunk(const SamplingConstants & k, const ChunkHeader & h, std::size_t chun
 __global__ void __launch_bounds__(SampleWarpsPerBlock * 32, 5)
 SampleTextureChunks(SamplingConstants k, const SampleTask * __restrict__ tasks,
                     const std::uint32_t * __restrict__ taskFirstChunk, const std::uint32_t * __restrict__ chunkTask,
-                    const std::uint32_t * __restrict__ totalChunks, std::size_t capacity, double2 * chunkSums)
+                    const std::uint32_t * __restrict__ totalChunks, std::size_t capacity, double2 * chunkSums,
+                    double * directionOut)
 {
   __shared__ float4 corners[SampleWarpsPerBlock][2][6];
   const int         warp = static_cast<int>(threadIdx.x / 32), lane = static_cast<int>(threadIdx.x & 31);
@@ -678,9 +690,9 @@ SampleTextureChunks(SamplingConstants k, const SampleTask * __restrict__ tasks,
   if (second)
     b = LoadChunk(tasks, taskFirstChunk, chunkTask, first + 1, lane, 8, corners[warp][1]);
   __syncwarp();
-  SampleChunk(k, a, first, lane, corners[warp][0], chunkSums);
+  SampleChunk(k, a, first, lane, corners[warp][0], chunkSums, directionOut);
   if (second)
-    SampleChunk(k, b, first + 1, lane, corners[warp][1], chunkSums);
+    SampleChunk(k, b, first + 1, lane, corners[warp][1], chunkSums, directionOut);
 }
 
 /** One warp per listed chunk (item, direction, the chunk's place among its
@@ -724,18 +736,19 @@ SampleListedChunks(SamplingConstants s, EvaluationConstants k, const double * __
   h.near = task.nearContour != 0;
   h.shift = make_uint4(task.shift[0], task.shift[1], task.shift[2], task.shift[3]);
   __syncwarp();
-  SampleChunk(s, h, entry, lane, taskCorners[warp], chunkSums);
+  SampleChunk(s, h, entry, lane, taskCorners[warp], chunkSums, nullptr);
 }
 
 /** Each direction's chunk sums in chunk order: the result does not depend on
- *  how the warps were scheduled. */
+ *  how the warps were scheduled. Tasks of one chunk have their values from
+ *  the sampling kernel already (SampleChunk). */
 __global__ void
 SumChunks(const SampleTask * __restrict__ tasks, const std::uint32_t * __restrict__ chunkCounts,
           const std::uint32_t * __restrict__ taskFirstChunk, const double2 * __restrict__ chunkSums,
           std::size_t tasksCount, std::size_t capacity, double * directionOut)
 {
   const std::size_t task = static_cast<std::size_t>(blockIdx.x) * blockDim.x + threadIdx.x;
-  if (task >= tasksCount)
+  if (task >= tasksCount || chunkCounts[task] == 1)
     return;
   const std::uint32_t first = taskFirstChunk[task];
   double              intensity = 0.0, guidance = 0.0;
@@ -900,7 +913,7 @@ LaunchSampleTexture(const EvaluationConstants & constants, std::size_t items, vo
     const std::size_t warps = (chunkCapacity + 1) / 2;
     const unsigned    sampleBlocks = static_cast<unsigned>((warps + SampleWarpsPerBlock - 1) / SampleWarpsPerBlock);
     SampleTextureChunks<<<sampleBlocks, SampleWarpsPerBlock * 32, 0, s>>>(
-      k, w.tasks, w.taskFirstChunk, chunkTask, w.scheduleEnds + tasks - 1, chunkCapacity, chunkSums);
+      k, w.tasks, w.taskFirstChunk, chunkTask, w.scheduleEnds + tasks - 1, chunkCapacity, chunkSums, directionOut);
     Check(cudaGetLastError(), "launching the texture sampling kernel");
   }
   SumChunks<<<taskBlocks, 256, 0, s>>>(w.tasks, w.chunkCounts, w.taskFirstChunk, chunkSums, tasks, chunkCapacity,
