@@ -56,10 +56,13 @@ using cuda::Check;
 // generations (2.5 % in late ones) at the same seconds per generation; 2
 // parts 2.8 % (3.9 %), but late generations were about 3 % slower; 1 part
 // 9.6 % in late ones, which took 24 % longer with nothing overlapping the
-// acceptance.
+// acceptance. With the sampling kernel's blocks of 20 warps, 2 parts against
+// 3 sampled 0.4 % more points per second in early generations and 1.6 % in
+// late ones (generations 341-380), at 0.0808 s per late generation against
+// 0.0821 s.
 // The last part's acceptance has nothing to overlap with, so that part is
 // smaller: LastPartShare of the others'.
-constexpr std::size_t MaxParts = 3;
+constexpr std::size_t MaxParts = 2;
 constexpr std::size_t MinItemsPerPart = 100000;
 constexpr double      LastPartShare = 0.5;
 // Room for this many times the most chunks per item seen so far. The

@@ -67,7 +67,17 @@ struct alignas(16) SampleTask
 static_assert(sizeof(SampleTask) == 128, "a task is one 128-byte line");
 
 constexpr int           PrepareThreads = 128;
-constexpr int           SampleWarpsPerBlock = 8;
+/** The sampling kernel's blocks: 40 warps per multiprocessor (48 registers
+ *  each), in blocks as large as that allows, since a block's warps take
+ *  consecutive chunks of the schedule and share its texels in the
+ *  multiprocessor's cache. On an H100 (20 early generations of the paper's
+ *  configuration, samples per second in kernels, in turns): 2 blocks of 20
+ *  warps 1.132e11, 4 of 10 1.129e11, 5 of 8 1.124e11, 2 of 16 (32 warps)
+ *  1.091e11; in another lease 10 blocks of 4 warps 1.013e11 against
+ *  1.122e11 for 5 of 8. Against 4 blocks of 8 warps (32 warps, 54
+ *  registers) 5 of 8 served 1.02 times the samples per second. */
+constexpr int           SampleWarpsPerBlock = 20;
+constexpr int           SampleBlocksPerMultiprocessor = 2;
 
 /** Step 1's workspace, 256-byte aligned parts. Tasks are numbered 2 item +
  *  direction; the schedule is the order in which warps take their chunks:
@@ -666,12 +676,12 @@ SampleChunk(const SamplingConstants & k, const ChunkHeader & h, std::size_t chun
     chunkSums[chunk] = make_double2(intensitySum, guidanceSum);
 }
 
-/** Two chunks per warp, in schedule order: consecutive blocks take the same
+/** Two chunks per warp, in schedule order: consecutive warps take the same
  *  tetrahedron of several solutions (see PrepareWorkspace). The second
- *  chunk's header loads while the first is sampled (62 registers, 4 blocks
- *  per SM as with one chunk): on an H100, 9.09e10 samples per second against
- *  9.02e10, the same sums. */
-__global__ void __launch_bounds__(SampleWarpsPerBlock * 32, 5)
+ *  chunk's header loads while the first is sampled: on an H100, 9.09e10
+ *  samples per second against 9.02e10 with one chunk per warp, the same
+ *  sums. */
+__global__ void __launch_bounds__(SampleWarpsPerBlock * 32, SampleBlocksPerMultiprocessor)
 SampleTextureChunks(SamplingConstants k, const SampleTask * __restrict__ tasks,
                     const std::uint32_t * __restrict__ taskFirstChunk, const std::uint32_t * __restrict__ chunkTask,
                     const std::uint32_t * __restrict__ totalChunks, std::size_t capacity, double2 * chunkSums,
