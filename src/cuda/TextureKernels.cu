@@ -75,7 +75,7 @@ constexpr int           PrepareThreads = 128;
  *  warps 1.132e11, 4 of 10 1.129e11, 5 of 8 1.124e11, 2 of 16 (32 warps)
  *  1.091e11; in another lease 10 blocks of 4 warps 1.013e11 against
  *  1.122e11 for 5 of 8. Against 4 blocks of 8 warps (32 warps, 54
- *  registers) 5 of 8 served 1.02 times the samples per second. */
+ *  registers) 5 of 8 served 1.009 times the samples per second. */
 constexpr int           SampleWarpsPerBlock = 20;
 constexpr int           SampleBlocksPerMultiprocessor = 2;
 
@@ -287,9 +287,9 @@ PrepareTextureTasks(EvaluationConstants k, const double * __restrict__ corners,
  *  z = k + 1/2, so the pair around z is layer floor(s), and s minus that is
  *  slice l's weight. Layers 0 and `top` pair the edge slice with itself, so
  *  outside them the weight does not matter and the layer is floor(min(s,
- *  top)), converted to 16 bits with saturation (negatives to 0): a value
- *  the compiler knows to fit the instruction's 16-bit layer field, so it
- *  adds no clamp of its own (two instructions per fetch instead of six).
+ *  top)) in one conversion that saturates (negatives to 0): with the
+ *  compiler's own clamp to the instruction's 16-bit layer field, which it
+ *  adds whatever the value, four instructions per fetch instead of six.
  *  One bilinear pass of 32-bit texels instead of a 3D texture's two passes,
  *  and the weight along z in single precision rather than the texture
  *  units' 8 fraction bits. On an H100, early generations' kernels sampled
