@@ -229,7 +229,7 @@ CudaEvaluationBackend::SamplePart(BatchFlight & f, std::size_t p)
   double *          directionValues = f.directionValues.Data() + begin * 2 * cuda::DirectionValues;
   if (UsesTexturePath())
   {
-    const auto capacity = static_cast<std::size_t>(std::ceil(m_ChunksPerItem * static_cast<double>(count))) + 1024;
+    const auto capacity = static_cast<std::size_t>(std::ceil(ChunkRoomPerItem() * static_cast<double>(count))) + 1024;
     f.chunkCapacity[p] = capacity;
     f.chunkWorkspaces[p]->Reserve(cuda::TextureChunkWorkspaceBytes(capacity));
     Check(cudaEventRecord(f.PartEvent(p, BatchFlight::SamplingStart), stream), "recording an event");
@@ -308,10 +308,7 @@ CudaEvaluationBackend::CompleteOverflowingPart(BatchFlight & f, std::size_t p, c
   // per item, and a room of 6 left half of the sampling grid's blocks
   // without a chunk.
   if (count > 0)
-  {
     m_MostChunksPerItem = std::max(m_MostChunksPerItem, static_cast<double>(chunks) / static_cast<double>(count));
-    m_ChunksPerItem = ChunkRoomMargin * m_MostChunksPerItem;
-  }
   if (chunks <= f.chunkCapacity[p])
     return;
   // Rare: once early in a run. The part's set-up is still in its workspace;

@@ -69,6 +69,8 @@ constexpr double      LastPartShare = 0.5;
 // sampling grid is sized for the room, and its blocks past the chunks leave
 // at once but still pass through the device's block scheduler.
 constexpr double ChunkRoomMargin = 1.25;
+// The room per item before any part's chunks are known.
+constexpr double FirstChunkRoomPerItem = 6.0;
 
 /** The texture path's textures of one image. */
 struct VolumeTextures
@@ -577,6 +579,14 @@ private:
   void
   SamplePart(BatchFlight & f, std::size_t p);
 
+  /** Room for chunks per item: the first guess, then the most seen so far
+   *  with ChunkRoomMargin. */
+  double
+  ChunkRoomPerItem() const
+  {
+    return m_MostChunksPerItem < 0.0 ? FirstChunkRoomPerItem : ChunkRoomMargin * m_MostChunksPerItem;
+  }
+
   /** Queues the sampling of the parts of flight `f` not yet queued (see
    *  SamplePart), then f.end. */
   void
@@ -650,10 +660,9 @@ private:
   std::unique_ptr<cuda::Event> m_MovedCopied;
   std::unique_ptr<BatchFlight>  m_Flights[2]; ///< as m_HostCandidates: the batch in flight, the next one
   const BatchFlight *           m_PreviousFlight{ nullptr }; ///< the last batch handed over, for its end
-  /** Room for chunks per item: a first guess, then the most seen so far
-   *  (m_MostChunksPerItem) with a margin. */
-  double                        m_ChunksPerItem{ 6.0 };
-  double                        m_MostChunksPerItem{ 0.0 };
+  /** The most chunks per item a part has held so far; negative before the
+   *  first (see ChunkRoomPerItem). */
+  double                        m_MostChunksPerItem{ -1.0 };
   cuda::EvaluationConstants     m_Constants;
   cuda::DeviceArray<float>      m_Moving, m_Fixed, m_PackedMoving, m_PackedFixed;
   VolumeTextures m_MovingTextures, m_FixedTextures;
