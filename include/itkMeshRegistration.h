@@ -36,8 +36,11 @@ struct MeshRegistrationOptions
   /** Continue from `checkpointPath` when it exists. */
   bool        resume{ false };
   std::size_t threads{ 0 }; ///< CPU backend threads (CUDA: host threads packing batches); 0: all
-  /** Which evaluation backend: the CPU, CUDA, or CUDA when a device is present. */
-  ::morea::BackendChoice backend{ ::morea::BackendChoice::Cpu };
+  /** Which evaluation backend: the CPU, CUDA (texture or exact
+   *  interpolation), or auto: the texture path when a device is usable. */
+  ::morea::BackendChoice backend{ ::morea::BackendChoice::Auto };
+  int                    device{ 0 };              ///< CUDA device ordinal
+  int                    minimumComputeLevel{ 0 }; ///< a device below this compute capability (x10) is not used
   /** Whether candidates that a bound shows refused go unsampled
    *  (morea/RefusalBound.h); the result is the same either way. */
   ::morea::RefusalBoundChoice refusalBounds{ ::morea::RefusalBoundChoice::Auto };
@@ -58,7 +61,9 @@ struct MeshRegistrationResult
   MeshModel                              model;
   std::vector<FrontSolution>             front; ///< the elitist archive, by ascending guidance
   std::vector<::morea::GenerationRecord> history;
-  std::string                            backend;
+  std::string                            backend;     ///< the backend's name: cpu, cuda-texture, cuda-exact
+  std::string                            backendNote; ///< why it runs there ("" when asked for by name and used)
+  std::string                            pathNote;    ///< a faster path the backend could not take, and why; "" when none
   std::size_t                            threads{ 0 };
   std::size_t                            resumedAtGeneration{ 0 }; ///< 0 when started afresh
   double                                 secondsModel{ 0.0 }; ///< the three below together

@@ -11,6 +11,7 @@
 #ifndef itkMeshTransforms_h
 #define itkMeshTransforms_h
 
+#include "itkCompositeTransform.h"
 #include "itkDisplacementFieldTransform.h"
 #include "itkMOREATypes.h"
 #include "itkRigidPreAlignment.h"
@@ -130,15 +131,30 @@ MeshFields
 RasterizeSolution(const ::morea::MeshTopology & topology, const ::morea::DualMesh & solution,
                   const ImageBase<Dimension> * fixedGrid, const ImageBase<Dimension> * movingGrid);
 
-/** Writes a solution's two transforms for the original images as ITK
- *  transform files (.h5 or .tfm; antsApplyTransforms, 3D Slicer and SimpleITK
- *  read them): composites of the rigid pre-alignment `rigid` (preprocessed
- *  frame -> original moving image; null: none) and the displacement fields,
- *  fixed -> moving as rigid(x + u(x)) and moving -> fixed as
- *  y' + v(y') with y' = rigid^-1(y). Atomic; throws on failure. */
+/** The transforms of a chosen solution between the original images: the
+ *  rigid pre-alignment composed with the solution's fields. */
+using CompositeTransformType = CompositeTransform<double, Dimension>;
+struct OriginalFrameTransforms
+{
+  /** Original fixed points -> original moving points, rigid(x + u(x)): the
+   *  transform to resample the original moving image onto the original fixed
+   *  grid with. Outside the preprocessed grid u is 0. */
+  CompositeTransformType::Pointer fixedToMoving;
+  /** Original moving points -> original fixed points, y' + v(y') with y' = rigid^-1(y). */
+  CompositeTransformType::Pointer movingToFixed;
+};
+
+/** Composes `fields` with the pre-alignment `rigid` (null: none). The
+ *  composites hold fresh field transforms (without inverse fields). */
+OriginalFrameTransforms
+MakeOriginalFrameTransforms(const MeshFields & fields, const RigidTransformType * rigid);
+
+/** Writes the two transforms between the original images as ITK transform
+ *  files (.h5 or .tfm; antsApplyTransforms, 3D Slicer and SimpleITK read
+ *  them). Atomic; throws on failure. */
 void
-WriteSolutionTransforms(const MeshFields & fields, const RigidTransformType * rigid,
-                        const std::string & fixedToMovingPath, const std::string & movingToFixedPath);
+WriteSolutionTransforms(const OriginalFrameTransforms & transforms, const std::string & fixedToMovingPath,
+                        const std::string & movingToFixedPath);
 
 /** Writes a mesh given in `frame` coordinates as a .vtu in physical space
  *  (ParaView, 3D Slicer); atomic. Tetrahedra are reordered to stay positively

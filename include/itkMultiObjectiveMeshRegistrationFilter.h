@@ -6,6 +6,7 @@
 
 #include "itkDataObjectDecorator.h"
 #include "itkMultiObjectiveMeshRegistrationFilterSupport.h"
+#include "itkPointSet.h"
 #include "itkProcessObject.h"
 #include "itkSimpleDataObjectDecorator.h"
 #include "morea/ParameterSet.h"
@@ -28,9 +29,13 @@ namespace itk
  * Inputs: the fixed image ("Fixed", primary) and the moving image ("Moving"),
  * both required; any 3D scalar types (cast to float internally). Structures
  * (organs, bones) are added by name with a binary mask on each image's grid
- * (AddStructure); optional body masks restrict the foreground. Parameters are a
- * ::morea::ParameterSet (the MOREA parameter-file keys), set whole, from a TOML
- * file, key by key or through the convenience setters.
+ * (AddStructure) and/or contour points on either image (AddStructurePoints,
+ * itk::PointSet in physical space, e.g. RTSTRUCT contours or points picked
+ * in 3D Slicer); optional body masks restrict the foreground; optional
+ * landmark point sets (SetFixedLandmarks, SetMovingLandmarks) are carried
+ * into the preprocessed frame for evaluation. Parameters are a
+ * ::morea::ParameterSet (the MOREA parameter-file keys), set whole, from a
+ * TOML file, key by key or through the convenience setters.
  *
  * The run: the problem is validated and preprocessed (isotropic resampling,
  * optional rigid pre-alignment on a structure, cropping, intensity window),
@@ -38,19 +43,25 @@ namespace itk
  * selection ("best-guidance", "knee", "weighted:a:b:c", "nearest:m:i:g",
  * "all"; comma-separated) are rasterised into displacement field transforms.
  *
- * Outputs: 0 is the approximation set (ApproximationSetDecorator), 1 the rigid
- * pre-alignment, then two transforms per chosen solution i: fixed to moving
- * (output 2 + 2i) and moving to fixed (output 3 + 2i). Their number depends on
- * the selection and the set, so they exist only after Update().
+ * Where it runs: SetBackend("auto") (the default) evaluates on the GPU's
+ * texture path when a usable CUDA device is present and on the CPU
+ * otherwise; "cuda" insists on the GPU (an error without one), "cuda-exact"
+ * is the GPU with software interpolation for verification, "cpu" the CPU.
+ * SetDevice picks the CUDA device (the cuda_gpu_id key), and
+ * SetNumberOfWorkUnits the host threads. GetBackendUsed() and
+ * GetBackendNote() say where it ran and why; the log (itkDebugMacro) and
+ * PrintSelf too.
  *
- * \warning The displacement field transforms live in the preprocessed frame:
- * their fields are on the preprocessed grid (GetPreprocessedFixedImage()), and
- * they relate the fixed image to the moving image *after* the rigid
- * pre-alignment. To map a fixed point x into the original moving image, apply
- * GetRigidTransform() after the fixed-to-moving transform, rigid(x + u(x));
- * e.g. a CompositeTransform with the rigid transform added first and the
- * displacement field transform second. Without pre-alignment
- * (preprocess_rigid_structure = "none") the rigid transform is the identity.
+ * Outputs: 0 is the approximation set (ApproximationSetDecorator), 1 the rigid
+ * pre-alignment, then four transforms per chosen solution i (they exist only
+ * after Update(), as their number depends on the selection and the set):
+ * between the original images, fixed to moving (2 + 4i) and moving to fixed
+ * (3 + 4i), composites of the pre-alignment and the solution's field: what
+ * ResampleImageFilter needs to map the original moving image onto the
+ * original fixed grid; and in the preprocessed frame, fixed to moving
+ * (4 + 4i) and moving to fixed (5 + 4i), displacement field transforms on the
+ * preprocessed grid (GetPreprocessedFixedImage()) relating the images after
+ * the pre-alignment.
  *
  * Events: IterationEvent after each generation (GetLastGenerationRecord()),
  * ProgressEvent; AbortGenerateData stops the run after the current generation
@@ -90,6 +101,11 @@ public:
   using ApproximationSetDecorator = SimpleDataObjectDecorator<ApproximationSetType>;
   using DecoratedRigidTransformType = DataObjectDecorator<RigidTransformType>;
   using DecoratedDisplacementFieldTransformType = DataObjectDecorator<DisplacementFieldTransformType>;
+  using CompositeTransformType = morea::CompositeTransformType;
+  using DecoratedCompositeTransformType = DataObjectDecorator<CompositeTransformType>;
+  /** Contour points and landmarks, in physical space (mm). */
+  using PointSetType = PointSet<float, 3>;
+  using RegistrationRunType = morea::MultiObjectiveRegistrationRun;
 
   using DataObjectPointerArraySizeType = ProcessObject::DataObjectPointerArraySizeType;
 
@@ -122,6 +138,24 @@ public:
   GetFixedStructureMask(const std::string & name) const;
   const MaskType *
   GetMovingStructureMask(const std::string & name) const;
+
+  /** Adds contour points of the structure `name` on either image (null:
+   *  none on that side), alone or beside its masks: each side needs a mask
+   *  or points at Update(). The points become the inputs
+   *  "FixedStructurePoints:<name>" and "MovingStructurePoints:<name>". */
+  virtual void
+  AddStructurePoints(const std::string & name, const PointSetType * fixedPoints, const PointSetType * movingPoints);
+  const PointSetType *
+  GetFixedStructurePoints(const std::string & name) const;
+  const PointSetType *
+  GetMovingStructurePoints(const std::string & name) const;
+
+  /** Optional corresponding landmarks (the same number on both images, in
+   *  the same order): carried into the preprocessed frame for evaluation. */
+  itkSetInputMacro(FixedLandmarks, PointSetType);
+  itkGetInputMacro(FixedLandmarks, PointSetType);
+  itkSetInputMacro(MovingLandmarks, PointSetType);
+  itkGetInputMacro(MovingLandmarks, PointSetType);
 
   /** Optional masks of the body on each image's grid; voxels outside are background. */
   itkSetInputMacro(FixedBodyMask, MaskType);
@@ -160,9 +194,25 @@ public:
   SizeValueType
   GetSeed() const;
 
-  /** CPU threads evaluating solutions; 0 (the default): all. */
-  itkSetMacro(NumberOfThreadsToUse, SizeValueType);
-  itkGetConstMacro(NumberOfThreadsToUse, SizeValueType);
+  /** Where the solutions are evaluated: "auto" (the default: the GPU's
+   *  texture path when a usable CUDA device is present, else the CPU),
+   *  "cuda" (the texture path; an error without a device), "cuda-exact"
+   *  (software interpolation on the GPU, for verification) or "cpu".
+   *  Anything else throws. Host threads: SetNumberOfWorkUnits. */
+  virtual void
+  SetBackend(const std::string & backend);
+  itkGetConstReferenceMacro(Backend, std::string);
+  /** The CUDA device ordinal (the cuda_gpu_id key). */
+  virtual void
+  SetDevice(SizeValueType device);
+  SizeValueType
+  GetDevice() const;
+  /** Whether candidates that a lower bound of their objectives shows refused
+   *  go unsampled: "auto" (the default: where it makes runs faster), "on" or
+   *  "off". The front is the same either way. */
+  virtual void
+  SetRefusalBounds(const std::string & choice);
+  itkGetConstReferenceMacro(RefusalBounds, std::string);
   /** Checkpoint file of the optimiser; empty (the default): none. */
   itkSetMacro(CheckpointFile, std::string);
   itkGetConstReferenceMacro(CheckpointFile, std::string);
@@ -200,18 +250,33 @@ public:
   const std::string &
   GetSelectedSolutionLabel(SizeValueType i) const;
 
-  /** Chosen solution i, fixed points to moving points (preprocessed frame):
-   *  the transform to resample the preprocessed moving image onto the fixed grid
-   *  with. Its inverse field is set, so GetInverseTransform() works. */
-  const DecoratedDisplacementFieldTransformType *
+  /** Chosen solution i between the original images, fixed points to moving
+   *  points: the pre-alignment composed with the solution's field, the
+   *  transform to resample the original moving image onto the original fixed
+   *  grid with. */
+  const DecoratedCompositeTransformType *
   GetFixedToMovingTransformOutput(SizeValueType i) const;
-  const DisplacementFieldTransformType *
+  const CompositeTransformType *
   GetFixedToMovingTransform(SizeValueType i) const;
-  /** Chosen solution i, moving points to fixed points (preprocessed frame). */
-  const DecoratedDisplacementFieldTransformType *
+  /** Chosen solution i between the original images, moving points to fixed points. */
+  const DecoratedCompositeTransformType *
   GetMovingToFixedTransformOutput(SizeValueType i) const;
-  const DisplacementFieldTransformType *
+  const CompositeTransformType *
   GetMovingToFixedTransform(SizeValueType i) const;
+
+  /** Chosen solution i in the preprocessed frame, fixed points to moving
+   *  points: the transform to resample the preprocessed moving image onto the
+   *  preprocessed grid with. Its inverse field is set, so
+   *  GetInverseTransform() works. */
+  const DecoratedDisplacementFieldTransformType *
+  GetPreprocessedFixedToMovingTransformOutput(SizeValueType i) const;
+  const DisplacementFieldTransformType *
+  GetPreprocessedFixedToMovingTransform(SizeValueType i) const;
+  /** Chosen solution i in the preprocessed frame, moving points to fixed points. */
+  const DecoratedDisplacementFieldTransformType *
+  GetPreprocessedMovingToFixedTransformOutput(SizeValueType i) const;
+  const DisplacementFieldTransformType *
+  GetPreprocessedMovingToFixedTransform(SizeValueType i) const;
 
   /** Rigid pre-alignment: preprocessed frame (fixed physical space) -> original moving image. */
   const DecoratedRigidTransformType *
@@ -224,17 +289,41 @@ public:
   const InternalImageType *
   GetPreprocessedFixedImage() const
   {
-    return m_PreprocessedFixedImage.GetPointer();
+    return m_Run.preprocessed.problem.fixedImage.GetPointer();
   }
   const InternalImageType *
   GetPreprocessedMovingImage() const
   {
-    return m_PreprocessedMovingImage.GetPointer();
+    return m_Run.preprocessed.problem.movingImage.GetPointer();
   }
   const PreprocessReportType &
   GetPreprocessReport() const
   {
-    return m_PreprocessReport;
+    return m_Run.preprocessed.report;
+  }
+
+  /** The backend the last run evaluated on: "cpu", "cuda-texture" or
+   *  "cuda-exact" ("" before a run). */
+  const std::string &
+  GetBackendUsed() const
+  {
+    return m_Run.registration.backend;
+  }
+  /** Why it ran there: the platform "auto" picked and why, and any faster
+   *  path that could not be taken; "" when the backend asked for by name ran
+   *  as asked. */
+  const std::string &
+  GetBackendNote() const
+  {
+    return m_Run.registration.backendNote;
+  }
+  /** Everything the last run made: the preprocessed problem, the mesh model
+   *  and the front with its meshes, the chosen solutions' fields, timings
+   *  (what `morea register` writes its folder from). */
+  const RegistrationRunType &
+  GetRegistrationRun() const
+  {
+    return m_Run;
   }
 
   /** The latest generation's statistics (during IterationEvent: the one just run). */
@@ -273,8 +362,17 @@ protected:
   void
   PrintSelf(std::ostream & os, Indent indent) const override;
 
-  /** Output index of chosen solution i's fixed-to-moving transform; +1 for moving-to-fixed. */
+  /** Output index of chosen solution i's first transform: FirstSolutionOutput
+   *  + OutputsPerSolution * i + one of the offsets below. */
   static constexpr DataObjectPointerArraySizeType FirstSolutionOutput = 2;
+  static constexpr DataObjectPointerArraySizeType OutputsPerSolution = 4;
+  enum SolutionOutputOffset : DataObjectPointerArraySizeType
+  {
+    FixedToMovingOutput = 0,
+    MovingToFixedOutput = 1,
+    PreprocessedFixedToMovingOutput = 2,
+    PreprocessedMovingToFixedOutput = 3
+  };
 
 private:
   template <typename TImage>
@@ -283,9 +381,15 @@ private:
 
   void
   CheckSolutionIndex(SizeValueType i) const;
+  const DataObject *
+  SolutionOutputAt(SizeValueType i, SolutionOutputOffset which) const;
+  /** The structures' masks and points as the problem holds them. */
+  std::vector<morea::Structure>
+  StructuresOfInputs() const;
 
   ParameterSetType                  m_Parameters{};
-  SizeValueType                     m_NumberOfThreadsToUse{ 0 };
+  std::string                       m_Backend{ "auto" };
+  std::string                       m_RefusalBounds{ "auto" };
   std::string                       m_CheckpointFile{};
   SizeValueType                     m_CheckpointInterval{ 0 };
   bool                              m_Resume{ false };
@@ -297,9 +401,7 @@ private:
   SizeValueType                     m_ResumedAtGeneration{ 0 };
   std::vector<SizeValueType>        m_SelectedSolutionIndices{};
   std::vector<std::string>          m_SelectedSolutionLabels{};
-  InternalImageType::Pointer         m_PreprocessedFixedImage{};
-  InternalImageType::Pointer         m_PreprocessedMovingImage{};
-  PreprocessReportType              m_PreprocessReport{};
+  RegistrationRunType               m_Run{};
 };
 } // namespace itk
 

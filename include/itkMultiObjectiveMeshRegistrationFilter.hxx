@@ -31,6 +31,36 @@ MovingStructureInputName(const std::string & name)
 {
   return "MovingStructure:" + name;
 }
+
+inline std::string
+FixedStructurePointsInputName(const std::string & name)
+{
+  return "FixedStructurePoints:" + name;
+}
+
+inline std::string
+MovingStructurePointsInputName(const std::string & name)
+{
+  return "MovingStructurePoints:" + name;
+}
+
+/** The points of a point set as the problem holds them; null: none. */
+template <typename TPointSet>
+PointListType
+ToPointList(const TPointSet * points)
+{
+  PointListType list;
+  if (!points || !points->GetPoints())
+    return list;
+  for (auto it = points->GetPoints()->Begin(); it != points->GetPoints()->End(); ++it)
+  {
+    PointType p;
+    for (unsigned d = 0; d < 3; ++d)
+      p[d] = static_cast<double>(it.Value()[d]);
+    list.push_back(p);
+  }
+  return list;
+}
 } // namespace detail
 } // namespace morea
 
@@ -44,6 +74,8 @@ MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::MultiObjectiveM
   // Optional named inputs.
   Self::SetInput("FixedBodyMask", nullptr);
   Self::SetInput("MovingBodyMask", nullptr);
+  Self::SetInput("FixedLandmarks", nullptr);
+  Self::SetInput("MovingLandmarks", nullptr);
 
   // The approximation set and the rigid transform always exist; the chosen
   // solutions' transforms are added by GenerateData.
@@ -114,8 +146,11 @@ MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::RemoveStructure
   const auto it = std::find(m_StructureNames.begin(), m_StructureNames.end(), name);
   if (it == m_StructureNames.end())
     return;
-  this->ProcessObject::RemoveInput(morea::detail::FixedStructureInputName(name));
-  this->ProcessObject::RemoveInput(morea::detail::MovingStructureInputName(name));
+  for (const auto & input :
+       { morea::detail::FixedStructureInputName(name), morea::detail::MovingStructureInputName(name),
+         morea::detail::FixedStructurePointsInputName(name), morea::detail::MovingStructurePointsInputName(name) })
+    if (this->ProcessObject::GetInput(input))
+      this->ProcessObject::RemoveInput(input);
   m_StructureNames.erase(it);
   this->Modified();
 }
@@ -127,6 +162,99 @@ MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::RemoveAllStruct
   const auto names = m_StructureNames;
   for (const auto & name : names)
     this->RemoveStructure(name);
+}
+
+template <typename TFixedImage, typename TMovingImage>
+void
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::AddStructurePoints(const std::string &  name,
+                                                                                    const PointSetType * fixedPoints,
+                                                                                    const PointSetType * movingPoints)
+{
+  if (name.empty())
+  {
+    itkExceptionMacro("AddStructurePoints: a structure needs a name");
+  }
+  if (!fixedPoints && !movingPoints)
+  {
+    itkExceptionMacro("AddStructurePoints: structure '" << name << "' needs points on at least one image");
+  }
+  this->ProcessObject::SetInput(morea::detail::FixedStructurePointsInputName(name),
+                                const_cast<PointSetType *>(fixedPoints));
+  this->ProcessObject::SetInput(morea::detail::MovingStructurePointsInputName(name),
+                                const_cast<PointSetType *>(movingPoints));
+  if (std::find(m_StructureNames.begin(), m_StructureNames.end(), name) == m_StructureNames.end())
+    m_StructureNames.push_back(name);
+  this->Modified();
+}
+
+template <typename TFixedImage, typename TMovingImage>
+auto
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GetFixedStructurePoints(const std::string & name) const
+  -> const PointSetType *
+{
+  return itkDynamicCastInDebugMode<const PointSetType *>(
+    this->ProcessObject::GetInput(morea::detail::FixedStructurePointsInputName(name)));
+}
+
+template <typename TFixedImage, typename TMovingImage>
+auto
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GetMovingStructurePoints(
+  const std::string & name) const -> const PointSetType *
+{
+  return itkDynamicCastInDebugMode<const PointSetType *>(
+    this->ProcessObject::GetInput(morea::detail::MovingStructurePointsInputName(name)));
+}
+
+template <typename TFixedImage, typename TMovingImage>
+void
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::SetBackend(const std::string & backend)
+{
+  try
+  {
+    ::morea::ParseBackendChoice(backend);
+  }
+  catch (const std::exception & e)
+  {
+    itkExceptionMacro(<< e.what());
+  }
+  if (backend != m_Backend)
+  {
+    m_Backend = backend;
+    this->Modified();
+  }
+}
+
+template <typename TFixedImage, typename TMovingImage>
+void
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::SetRefusalBounds(const std::string & choice)
+{
+  try
+  {
+    ::morea::ParseRefusalBoundChoice(choice);
+  }
+  catch (const std::exception & e)
+  {
+    itkExceptionMacro(<< e.what());
+  }
+  if (choice != m_RefusalBounds)
+  {
+    m_RefusalBounds = choice;
+    this->Modified();
+  }
+}
+
+template <typename TFixedImage, typename TMovingImage>
+void
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::SetDevice(SizeValueType device)
+{
+  this->SetParameter("cuda_gpu_id", std::to_string(device));
+}
+
+template <typename TFixedImage, typename TMovingImage>
+SizeValueType
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GetDevice() const
+{
+  return static_cast<SizeValueType>(m_Parameters.GetInteger("cuda_gpu_id"));
 }
 
 template <typename TFixedImage, typename TMovingImage>
@@ -243,7 +371,35 @@ MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::MakeOutput(Data
     decorator->Set(rigid);
     return decorator.GetPointer();
   }
+  if ((idx - FirstSolutionOutput) % OutputsPerSolution < PreprocessedFixedToMovingOutput)
+    return DecoratedCompositeTransformType::New().GetPointer();
   return DecoratedDisplacementFieldTransformType::New().GetPointer();
+}
+
+template <typename TFixedImage, typename TMovingImage>
+std::vector<morea::Structure>
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::StructuresOfInputs() const
+{
+  std::vector<morea::Structure> structures;
+  for (const auto & name : m_StructureNames)
+  {
+    morea::Structure structure;
+    structure.name = name;
+    structure.fixedMask = const_cast<MaskType *>(this->GetFixedStructureMask(name));
+    structure.movingMask = const_cast<MaskType *>(this->GetMovingStructureMask(name));
+    const PointSetType * fixedPoints = this->GetFixedStructurePoints(name);
+    const PointSetType * movingPoints = this->GetMovingStructurePoints(name);
+    // A point set given but empty is a mistake, not "no points".
+    for (const auto & [points, side] : { std::make_pair(fixedPoints, "fixed"), std::make_pair(movingPoints, "moving") })
+      if (points && points->GetNumberOfPoints() == 0)
+      {
+        itkExceptionMacro("structure '" << name << "': the " << side << " point set is empty");
+      }
+    structure.fixedPoints = morea::detail::ToPointList(fixedPoints);
+    structure.movingPoints = morea::detail::ToPointList(movingPoints);
+    structures.push_back(std::move(structure));
+  }
+  return structures;
 }
 
 template <typename TFixedImage, typename TMovingImage>
@@ -297,9 +453,7 @@ MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GenerateData()
   m_ResumedAtGeneration = 0;
   m_SelectedSolutionIndices.clear();
   m_SelectedSolutionLabels.clear();
-  m_PreprocessedFixedImage = nullptr;
-  m_PreprocessedMovingImage = nullptr;
-  m_PreprocessReport = {};
+  m_Run = {};
   static_cast<ApproximationSetDecorator *>(this->ProcessObject::GetOutput(0))->Set(ApproximationSetType{});
   this->SetNumberOfIndexedOutputs(FirstSolutionOutput);
   this->UpdateProgress(0.0f);
@@ -310,22 +464,25 @@ MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GenerateData()
     morea::RegistrationProblem problem;
     problem.fixedImage = ToInternalImage(this->GetFixedImage());
     problem.movingImage = ToInternalImage(this->GetMovingImage());
-    for (const auto & name : m_StructureNames)
-    {
-      morea::Structure structure;
-      structure.name = name;
-      structure.fixedMask = const_cast<MaskType *>(this->GetFixedStructureMask(name));
-      structure.movingMask = const_cast<MaskType *>(this->GetMovingStructureMask(name));
-      problem.structures.push_back(std::move(structure));
-    }
+    problem.structures = this->StructuresOfInputs();
     problem.fixedBodyMask = const_cast<MaskType *>(this->GetFixedBodyMask());
     problem.movingBodyMask = const_cast<MaskType *>(this->GetMovingBodyMask());
+    problem.fixedLandmarks = morea::detail::ToPointList(this->GetFixedLandmarks());
+    problem.movingLandmarks = morea::detail::ToPointList(this->GetMovingLandmarks());
+    if (problem.fixedLandmarks.size() != problem.movingLandmarks.size())
+    {
+      itkExceptionMacro("landmarks: " << problem.fixedLandmarks.size() << " fixed and "
+                                      << problem.movingLandmarks.size()
+                                      << " moving points; both sets need the same points in the same order");
+    }
 
     morea::MeshRegistrationOptions options;
     options.checkpointPath = m_CheckpointFile;
     options.checkpointInterval = m_CheckpointInterval;
     options.resume = m_Resume;
-    options.threads = m_NumberOfThreadsToUse;
+    options.threads = this->GetNumberOfWorkUnits();
+    options.backend = ::morea::ParseBackendChoice(m_Backend);
+    options.refusalBounds = ::morea::ParseRefusalBoundChoice(m_RefusalBounds);
     // Between generations is the only point the run can stop at cleanly; both
     // callbacks check, so that an observer of either event stops it at once.
     const auto stopIfAborted = [this]() {
@@ -358,31 +515,42 @@ MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GenerateData()
     itkExceptionMacro(<< e.what());
   }
 
-  m_GenerationHistory = std::move(run.history);
+  m_GenerationHistory = run.registration.history;
   if (!m_GenerationHistory.empty())
     m_LastGenerationRecord = m_GenerationHistory.back();
-  m_ResumedAtGeneration = static_cast<SizeValueType>(run.resumedAtGeneration);
-  m_PreprocessedFixedImage = run.preprocessedFixedImage;
-  m_PreprocessedMovingImage = run.preprocessedMovingImage;
-  m_PreprocessReport = run.preprocessReport;
-
+  m_ResumedAtGeneration = static_cast<SizeValueType>(run.registration.resumedAtGeneration);
   static_cast<ApproximationSetDecorator *>(this->ProcessObject::GetOutput(0))->Set(run.approximationSet);
-  static_cast<DecoratedRigidTransformType *>(this->ProcessObject::GetOutput(1))->Set(run.rigidTransform);
+  static_cast<DecoratedRigidTransformType *>(this->ProcessObject::GetOutput(1))->Set(run.preprocessed.rigidTransform);
 
-  this->SetNumberOfIndexedOutputs(FirstSolutionOutput + 2 * run.selected.size());
+  this->SetNumberOfIndexedOutputs(FirstSolutionOutput + OutputsPerSolution * run.selected.size());
   for (std::size_t i = 0; i < run.selected.size(); ++i)
   {
     const auto & selected = run.selected[i];
     m_SelectedSolutionIndices.push_back(static_cast<SizeValueType>(selected.choice.index));
     m_SelectedSolutionLabels.push_back(selected.choice.label);
-    const DataObjectPointerArraySizeType first = FirstSolutionOutput + 2 * i;
-    for (DataObjectPointerArraySizeType o : { first, first + 1 })
+    const DataObjectPointerArraySizeType first = FirstSolutionOutput + OutputsPerSolution * i;
+    for (DataObjectPointerArraySizeType o = first; o < first + OutputsPerSolution; ++o)
       if (this->ProcessObject::GetOutput(o) == nullptr)
         this->SetNthOutput(o, this->MakeOutput(o));
-    static_cast<DecoratedDisplacementFieldTransformType *>(this->ProcessObject::GetOutput(first))
-      ->Set(selected.fixedToMoving);
-    static_cast<DecoratedDisplacementFieldTransformType *>(this->ProcessObject::GetOutput(first + 1))
-      ->Set(selected.movingToFixed);
+    const auto composite = [&](DataObjectPointerArraySizeType o) {
+      return static_cast<DecoratedCompositeTransformType *>(this->ProcessObject::GetOutput(first + o));
+    };
+    const auto field = [&](DataObjectPointerArraySizeType o) {
+      return static_cast<DecoratedDisplacementFieldTransformType *>(this->ProcessObject::GetOutput(first + o));
+    };
+    composite(FixedToMovingOutput)->Set(selected.original.fixedToMoving);
+    composite(MovingToFixedOutput)->Set(selected.original.movingToFixed);
+    field(PreprocessedFixedToMovingOutput)->Set(selected.fields.fixedToMovingTransform);
+    field(PreprocessedMovingToFixedOutput)->Set(selected.fields.movingToFixedTransform);
+  }
+  m_Run = std::move(run);
+  itkDebugMacro("evaluated on the " << m_Run.registration.backend << " backend"
+                                    << (m_Run.registration.backendNote.empty() ? "" : ": ")
+                                    << m_Run.registration.backendNote);
+  // A faster path the backend could not take is said, never dropped.
+  if (!m_Run.registration.pathNote.empty())
+  {
+    itkWarningMacro("backend: " << m_Run.registration.pathNote);
   }
   this->UpdateProgress(1.0f);
 }
@@ -432,19 +600,26 @@ MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GetSelectedSolu
 }
 
 template <typename TFixedImage, typename TMovingImage>
-auto
-MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GetFixedToMovingTransformOutput(
-  SizeValueType i) const -> const DecoratedDisplacementFieldTransformType *
+const DataObject *
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::SolutionOutputAt(SizeValueType i,
+                                                                                SolutionOutputOffset which) const
 {
   this->CheckSolutionIndex(i);
-  return static_cast<const DecoratedDisplacementFieldTransformType *>(
-    this->ProcessObject::GetOutput(FirstSolutionOutput + 2 * i));
+  return this->ProcessObject::GetOutput(FirstSolutionOutput + OutputsPerSolution * i + which);
+}
+
+template <typename TFixedImage, typename TMovingImage>
+auto
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GetFixedToMovingTransformOutput(
+  SizeValueType i) const -> const DecoratedCompositeTransformType *
+{
+  return static_cast<const DecoratedCompositeTransformType *>(this->SolutionOutputAt(i, FixedToMovingOutput));
 }
 
 template <typename TFixedImage, typename TMovingImage>
 auto
 MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GetFixedToMovingTransform(SizeValueType i) const
-  -> const DisplacementFieldTransformType *
+  -> const CompositeTransformType *
 {
   return this->GetFixedToMovingTransformOutput(i)->Get();
 }
@@ -452,19 +627,51 @@ MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GetFixedToMovin
 template <typename TFixedImage, typename TMovingImage>
 auto
 MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GetMovingToFixedTransformOutput(
-  SizeValueType i) const -> const DecoratedDisplacementFieldTransformType *
+  SizeValueType i) const -> const DecoratedCompositeTransformType *
 {
-  this->CheckSolutionIndex(i);
-  return static_cast<const DecoratedDisplacementFieldTransformType *>(
-    this->ProcessObject::GetOutput(FirstSolutionOutput + 2 * i + 1));
+  return static_cast<const DecoratedCompositeTransformType *>(this->SolutionOutputAt(i, MovingToFixedOutput));
 }
 
 template <typename TFixedImage, typename TMovingImage>
 auto
 MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GetMovingToFixedTransform(SizeValueType i) const
-  -> const DisplacementFieldTransformType *
+  -> const CompositeTransformType *
 {
   return this->GetMovingToFixedTransformOutput(i)->Get();
+}
+
+template <typename TFixedImage, typename TMovingImage>
+auto
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GetPreprocessedFixedToMovingTransformOutput(
+  SizeValueType i) const -> const DecoratedDisplacementFieldTransformType *
+{
+  return static_cast<const DecoratedDisplacementFieldTransformType *>(
+    this->SolutionOutputAt(i, PreprocessedFixedToMovingOutput));
+}
+
+template <typename TFixedImage, typename TMovingImage>
+auto
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GetPreprocessedFixedToMovingTransform(
+  SizeValueType i) const -> const DisplacementFieldTransformType *
+{
+  return this->GetPreprocessedFixedToMovingTransformOutput(i)->Get();
+}
+
+template <typename TFixedImage, typename TMovingImage>
+auto
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GetPreprocessedMovingToFixedTransformOutput(
+  SizeValueType i) const -> const DecoratedDisplacementFieldTransformType *
+{
+  return static_cast<const DecoratedDisplacementFieldTransformType *>(
+    this->SolutionOutputAt(i, PreprocessedMovingToFixedOutput));
+}
+
+template <typename TFixedImage, typename TMovingImage>
+auto
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GetPreprocessedMovingToFixedTransform(
+  SizeValueType i) const -> const DisplacementFieldTransformType *
+{
+  return this->GetPreprocessedMovingToFixedTransformOutput(i)->Get();
 }
 
 template <typename TFixedImage, typename TMovingImage>
@@ -493,7 +700,10 @@ MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::PrintSelf(std::
     os << (i ? ", " : "") << m_StructureNames[i];
   os << std::endl;
   os << indent << "Selection: " << m_Selection << std::endl;
-  os << indent << "NumberOfThreadsToUse: " << m_NumberOfThreadsToUse << std::endl;
+  os << indent << "Backend: " << m_Backend << std::endl;
+  os << indent << "BackendUsed: " << (this->GetBackendUsed().empty() ? "(none yet)" : this->GetBackendUsed())
+     << std::endl;
+  os << indent << "BackendNote: " << this->GetBackendNote() << std::endl;
   os << indent << "CheckpointFile: " << m_CheckpointFile << std::endl;
   os << indent << "CheckpointInterval: " << m_CheckpointInterval << std::endl;
   os << indent << "Resume: " << (m_Resume ? "On" : "Off") << std::endl;
@@ -508,9 +718,8 @@ MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::PrintSelf(std::
     os << " " << m_SelectedSolutionLabels[i] << "=" << m_SelectedSolutionIndices[i];
   os << std::endl;
   os << indent << "PreprocessedGrid: ";
-  if (m_PreprocessedFixedImage)
-    os << m_PreprocessedFixedImage->GetLargestPossibleRegion().GetSize() << " voxels of "
-       << m_PreprocessedFixedImage->GetSpacing()[0] << " mm" << std::endl;
+  if (const auto * grid = this->GetPreprocessedFixedImage())
+    os << grid->GetLargestPossibleRegion().GetSize() << " voxels of " << grid->GetSpacing()[0] << " mm" << std::endl;
   else
     os << "(none)" << std::endl;
 }

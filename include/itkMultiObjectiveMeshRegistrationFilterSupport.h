@@ -68,26 +68,27 @@ CheckSolutionSelection(const std::string & selection);
 std::vector<SolutionChoice>
 SelectSolutions(const ApproximationSet & set, const std::string & selection);
 
-/** A chosen solution's registration in the preprocessed frame. */
+/** A chosen solution: its fields and transforms in the preprocessed frame
+ *  and its transforms between the original images. */
 struct SelectedSolution
 {
-  SolutionChoice                          choice;
-  DisplacementFieldTransformType::Pointer fixedToMoving;
-  DisplacementFieldTransformType::Pointer movingToFixed;
+  SolutionChoice          choice;
+  MeshFields              fields;
+  OriginalFrameTransforms original;
 };
 
-/** Everything the filter outputs, from one run. */
+/** Everything one registration makes, from reading the inputs to the chosen
+ *  solutions' transforms: what the filter outputs and what
+ *  `morea register` writes. */
 struct MultiObjectiveRegistrationRun
 {
-  ImageType::Pointer                     preprocessedFixedImage;
-  ImageType::Pointer                     preprocessedMovingImage;
-  RigidTransformType::Pointer            rigidTransform; ///< preprocessed frame -> original moving image
-  PreprocessReport                       preprocessReport;
-  ApproximationSet                       approximationSet;
-  std::vector<SelectedSolution>          selected;
-  std::vector<::morea::GenerationRecord> history;
-  std::string                            backend;
-  std::size_t                            resumedAtGeneration{ 0 };
+  PreprocessResult              preprocessed; ///< the problem on the preprocessed grid, the rigid pre-alignment
+  MeshRegistrationResult        registration; ///< mesh model, front with meshes, history, backend
+  ApproximationSet              approximationSet;
+  std::vector<SelectedSolution> selected;
+  double                        secondsPreprocessing{ 0.0 };
+  double                        secondsRegistration{ 0.0 }; ///< model and optimisation
+  double                        secondsSelection{ 0.0 };    ///< rasterising the chosen solutions
 };
 
 /** Shares of the progress range: preprocessing and mesh model up to the first,
@@ -95,10 +96,18 @@ struct MultiObjectiveRegistrationRun
 constexpr double PreprocessingProgressShare = 0.05;
 constexpr double OptimisationProgressEnd = 0.95;
 
+/** Refuses, with a message naming the key, parameter values one
+ *  registration cannot honour: num_runs > 1 (the command line runs several)
+ *  and zip = true (the filter writes no folder). Throws ::morea::Error. */
+void
+CheckSingleRunParameters(const ::morea::ParameterSet & parameters);
+
 /** Validates `problem`, preprocesses it, runs MOREA and rasterises the
- *  solutions `selection` names on the preprocessed grid. `progress` (may be
- *  empty) gets the cumulative fraction done; it and `options.onGeneration` may
- *  throw to abort. Throws ::morea::Error (or what the callbacks throw). */
+ *  solutions `selection` names on the preprocessed grid. The CUDA device and
+ *  its lowest compute level come from the parameters (cuda_gpu_id,
+ *  cuda_compute_level). `progress` (may be empty) gets the cumulative
+ *  fraction done; it and `options.onGeneration` may throw to abort. Throws
+ *  ::morea::Error (or what the callbacks throw). */
 MultiObjectiveRegistrationRun
 RunMultiObjectiveRegistration(const RegistrationProblem & problem, const ::morea::ParameterSet & parameters,
                               const MeshRegistrationOptions & options, const std::string & selection,

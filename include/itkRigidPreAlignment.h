@@ -40,6 +40,9 @@ struct RigidAlignmentResult
   double       initialMetric{ 0.0 };
   double       finalMetric{ 0.0 };   ///< of the mask stage
   bool         intensityRefined{ false };
+  /** Why the intensity stage did not run though both images were given
+   *  (the structure's interior too small to sample); "" otherwise. */
+  std::string  intensitySkipped;
   double       intensityMetric{ 0.0 }; ///< final value of the intensity stage (-correlation)
   unsigned int iterations{ 0 };
   double       translation[3]{ 0, 0, 0 }; ///< mm

@@ -704,32 +704,56 @@ TEST(CudaEvaluationBackend, TextureWholeChunksSampleTheCpuPoints)
 TEST(EvaluationBackendSelection, NamesAndDeviceAbsence)
 {
   EXPECT_EQ(ParseBackendChoice("cpu"), BackendChoice::Cpu);
-  EXPECT_EQ(ParseBackendChoice("cuda"), BackendChoice::Cuda);
+  EXPECT_EQ(ParseBackendChoice("cuda"), BackendChoice::CudaTexture);
   EXPECT_EQ(ParseBackendChoice("cuda-texture"), BackendChoice::CudaTexture);
+  EXPECT_EQ(ParseBackendChoice("cuda-exact"), BackendChoice::CudaExact);
   EXPECT_EQ(ParseBackendChoice("auto"), BackendChoice::Auto);
+  for (auto choice : { BackendChoice::Cpu, BackendChoice::CudaTexture, BackendChoice::CudaExact, BackendChoice::Auto })
+    EXPECT_EQ(ParseBackendChoice(BackendChoiceName(choice)), choice);
   EXPECT_THROW(ParseBackendChoice("gpu"), Error);
   OptimiserTestProblem problem;
   EXPECT_EQ(CreateEvaluationBackend(BackendChoice::Cpu, *problem.evaluator, 1)->Name(), "cpu");
   const std::string reason = CudaUnavailableReason();
-  auto              automatic = CreateEvaluationBackend(BackendChoice::Auto, *problem.evaluator, 1);
-  EXPECT_EQ(automatic->Name(), reason.empty() ? "cuda" : "cpu");
+  // Auto takes the fast path on a device and says why it ran where it did.
+  BackendRequest request;
+  request.threads = 1;
+  std::string note;
+  auto        automatic = CreateEvaluationBackend(request, *problem.evaluator, &note);
+  EXPECT_EQ(automatic->Name(), reason.empty() ? "cuda-texture" : "cpu");
+  EXPECT_NE(note.find(reason.empty() ? "texture path" : "the CPU"), std::string::npos) << note;
+  // A device index out of range, named on purpose: an error for every CUDA-capable choice.
+  request.device = 64;
+  EXPECT_THROW(CreateEvaluationBackend(request, *problem.evaluator), Error);
+  request.choice = BackendChoice::CudaTexture;
+  EXPECT_THROW(CreateEvaluationBackend(request, *problem.evaluator), Error);
+  request.choice = BackendChoice::Cpu;
+  EXPECT_EQ(CreateEvaluationBackend(request, *problem.evaluator)->Name(), "cpu");
+  request.choice = BackendChoice::CudaTexture;
   if (!reason.empty())
   {
     // No device (or no CUDA in the build): a clear error, not a crash.
     try
     {
-      CreateEvaluationBackend(BackendChoice::Cuda, *problem.evaluator, 1);
+      CreateEvaluationBackend(BackendChoice::CudaExact, *problem.evaluator, 1);
       ADD_FAILURE() << "expected an error";
     }
     catch (const Error & e)
     {
-      EXPECT_NE(std::string(e.what()).find("CUDA backend"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("backend 'cuda-exact'"), std::string::npos) << e.what();
     }
     EXPECT_THROW(CreateEvaluationBackend(BackendChoice::CudaTexture, *problem.evaluator, 1), Error);
   }
   else
   {
     EXPECT_EQ(CreateEvaluationBackend(BackendChoice::CudaTexture, *problem.evaluator, 1)->Name(), "cuda-texture");
+    EXPECT_EQ(CreateEvaluationBackend(BackendChoice::CudaExact, *problem.evaluator, 1)->Name(), "cuda");
+    // A compute level above any device's: refused by name, the CPU for auto.
+    request.device = 0;
+    request.minimumComputeLevel = 200;
+    EXPECT_THROW(CreateEvaluationBackend(request, *problem.evaluator), Error);
+    request.choice = BackendChoice::Auto;
+    EXPECT_EQ(CreateEvaluationBackend(request, *problem.evaluator, &note)->Name(), "cpu");
+    EXPECT_NE(note.find("cuda_compute_level"), std::string::npos) << note;
   }
 }
 
@@ -1034,4 +1058,141 @@ TEST(CudaEvaluationBackend, FoldChecksAndRepairAgreeWithTheCpu)
       else
         EXPECT_EQ(repaired, 0u) << what;
     }
+}
+
+// The texture path reads each structure's distances from textures of its own,
+// only near its contour (a near-block mask of 4, 8 or 16 bits per block), for
+// up to cuda::MaxTextureStructures structures: with 1, 3, 4, 5, 8 and 16 crossing
+// spheres (each mask width and kernel instance), whole solutions and partial
+// candidates agree with the CPU as the one-structure texture tests do: the
+// same sample counts and folds, magnitudes to 1e-9, objectives to 1e-2.
+TEST(CudaEvaluationBackend, TexturePathAgreesWithTheCpuForManyStructures)
+{
+  MOREA_REQUIRE_CUDA_DEVICE();
+  for (const std::size_t structures : { 1u, 3u, 4u, 5u, 8u, 16u })
+  {
+    const std::string what = std::to_string(structures) + " structures";
+    OptimiserTestProblem problem;
+    problem.UseStructures(structures);
+    problem.data.samplingRate = 2.0;
+    GomeaOptions options = problem.Options(9);
+    options.populationSize = 4;
+    const auto population = problem.InitialPopulation(options);
+    auto       cpu = CreateCpuEvaluationBackend(*problem.evaluator, 2);
+    auto       texture = CreateCudaEvaluationBackend(*problem.evaluator, 2, CudaInterpolation::Texture);
+    EXPECT_EQ(texture->Name(), "cuda-texture") << what;
+    EXPECT_EQ(texture->PathNote(), "") << what;
+
+    const auto a = EvaluateAll(*cpu, population);
+    const auto b = EvaluateAll(*texture, population);
+    for (std::size_t s = 0; s < population.size(); ++s)
+    {
+      ObjectiveTotals ta, tb;
+      for (std::size_t t = 0; t < a[s].size(); ++t)
+      {
+        EXPECT_EQ(a[s][t].samples, b[s][t].samples) << what;
+        EXPECT_EQ(a[s][t].folded, b[s][t].folded) << what;
+        ExpectRelativelyClose(a[s][t].magnitude, b[s][t].magnitude, 1e-9, what + " magnitude");
+        ta.Add(a[s][t]);
+        tb.Add(b[s][t]);
+      }
+      const Fitness fa = ta.ToFitness(a[s].size()), fb = tb.ToFitness(b[s].size());
+      EXPECT_GT(fa.objectives[2], 0.0) << what << ": no guidance to compare";
+      for (std::size_t m = 0; m < NumberOfObjectives; ++m)
+        ExpectRelativelyClose(fa.objectives[m], fb.objectives[m], 1e-2,
+                              what + ", solution " + std::to_string(s) + ", objective " + std::to_string(m));
+      if (s == 0)
+        std::cout << what << ": guidance cpu " << fa.objectives[2] << " texture " << fb.objectives[2] << "\n";
+    }
+
+    // Partial candidates of the first two groups (through the batch path:
+    // corners built on the device, the parts' schedule), the same check
+    // over each batch.
+    for (std::size_t g = 0; g < 2; ++g)
+    {
+      const auto &                 group = problem.parallel.groups[g];
+      morea_test::RandomCandidates onCpu(problem, population, group, 1.5, 41 + g);
+      morea_test::RandomCandidates onGpu(problem, population, group, 1.5, 41 + g);
+      cpu->EvaluatePartials(onCpu.candidates);
+      texture->EvaluatePartials(onGpu.candidates);
+      ObjectiveTotals ta, tb;
+      std::size_t     count = 0;
+      for (std::size_t i = 0; i < onCpu.candidates.size(); ++i)
+        for (std::size_t t = 0; t < onCpu.values[i].size(); ++t, ++count)
+        {
+          const TetrahedronValues &x = onCpu.values[i][t], &y = onGpu.values[i][t];
+          EXPECT_EQ(x.samples, y.samples) << what << ", group " << g << ", candidate " << i;
+          EXPECT_EQ(x.folded, y.folded) << what << ", group " << g << ", candidate " << i;
+          ExpectRelativelyClose(x.magnitude, y.magnitude, 1e-9, what + " candidate magnitude");
+          ta.Add(x);
+          tb.Add(y);
+        }
+      ASSERT_GT(count, 0u);
+      const Fitness fa = ta.ToFitness(count), fb = tb.ToFitness(count);
+      EXPECT_GT(fa.objectives[2], 0.0) << what << ": no guidance to compare";
+      for (std::size_t m = 0; m < NumberOfObjectives; ++m)
+        ExpectRelativelyClose(fa.objectives[m], fb.objectives[m], 1e-2,
+                              what + ", candidates of group " + std::to_string(g) + ", objective " +
+                                std::to_string(m));
+    }
+  }
+}
+
+// Candidates a refusal bound skipped and the optimiser needs after all are
+// sampled chunk by chunk (LaunchSampleListedChunks, the kernel instance for
+// the structures too): with 5 and 16 structures, the same sums as the
+// batches' sampling, so a run ends exactly as one that samples everything.
+TEST(CudaEvaluationBackend, TexturePathWithManyStructuresSamplesSkippedCandidatesAlike)
+{
+  MOREA_REQUIRE_CUDA_DEVICE();
+  for (const std::size_t structures : { 5u, 16u })
+  {
+    OptimiserTestProblem problem;
+    problem.UseStructures(structures);
+    const GomeaOptions options = problem.Options(31, 12);
+    GomeaOptions       sampleAll = options;
+    sampleAll.boundRefusals = false;
+    auto       backend = CreateCudaEvaluationBackend(*problem.evaluator, 2, CudaInterpolation::Texture);
+    const auto all = RunToEnd(problem, *backend, sampleAll);
+    const auto bounded = RunToEnd(problem, *backend, options);
+    ExpectSameDecisions(all, bounded, std::to_string(structures) + " structures");
+    std::size_t later = 0;
+    for (const GenerationRecord & g : bounded.second)
+      later += g.boundSampledLater;
+    EXPECT_GT(later, 0u) << structures << " structures: no skipped candidate was sampled later";
+  }
+}
+
+// Asked for, the texture path runs up to cuda::MaxTextureStructures (16)
+// structures and says nothing; with more, the backend runs the exact kernels
+// (named "cuda", agreeing with the CPU to the exact path's 1e-4) and says
+// which path it took and why, rather than falling back silently.
+TEST(CudaEvaluationBackend, TexturePathRunsUpToSixteenStructuresAndNamesItsFallback)
+{
+  MOREA_REQUIRE_CUDA_DEVICE();
+  for (const std::size_t structures : { 5u, 8u, 16u })
+  {
+    OptimiserTestProblem problem;
+    problem.UseStructures(structures);
+    auto texture = CreateCudaEvaluationBackend(*problem.evaluator, 2, CudaInterpolation::Texture);
+    EXPECT_EQ(texture->Name(), "cuda-texture") << structures << " structures";
+    EXPECT_EQ(texture->PathNote(), "") << structures << " structures";
+    EXPECT_EQ(CreateCudaEvaluationBackend(*problem.evaluator, 2, CudaInterpolation::Exact)->PathNote(), "");
+  }
+  OptimiserTestProblem problem;
+  problem.UseStructures(17);
+  auto fallback = CreateCudaEvaluationBackend(*problem.evaluator, 2, CudaInterpolation::Texture);
+  EXPECT_EQ(fallback->Name(), "cuda");
+  const std::string note = fallback->PathNote();
+  EXPECT_NE(note.find("exact CUDA kernels instead of the texture path"), std::string::npos) << note;
+  EXPECT_NE(note.find("17 guidance structures"), std::string::npos) << note;
+  EXPECT_NE(note.find("at most 16"), std::string::npos) << note;
+  GomeaOptions options = problem.Options(9);
+  options.populationSize = 2;
+  const auto population = problem.InitialPopulation(options);
+  auto       cpu = CreateCpuEvaluationBackend(*problem.evaluator, 2);
+  const auto a = EvaluateAll(*cpu, population);
+  const auto b = EvaluateAll(*fallback, population);
+  for (std::size_t s = 0; s < population.size(); ++s)
+    ExpectSameTotals(a[s], b[s], "17 structures, solution " + std::to_string(s));
 }

@@ -3,12 +3,17 @@
 #include "itkCommand.h"
 #include "itkImageRegionIteratorWithIndex.h"
 #include "itkMultiObjectiveMeshRegistrationFilter.h"
+#include "itkRegistrationEvaluation.h"
+#include "itkResampleImageFilter.h"
+#include "itkTransformFileReader.h"
+#include "morea/ComputeDevices.h"
 #include "morea/ParetoFront.h"
 
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <sstream>
+#include <tuple>
 
 using namespace itk::morea;
 
@@ -119,7 +124,8 @@ MakeFilter(const Problem & problem)
   filter->SetParameter("morea_sampling_rate", "0.3");
   filter->SetParameter("preprocess_rigid_structure", "none");
   filter->SetParameter("preprocess_isotropic_spacing", "2.0");
-  filter->SetNumberOfThreadsToUse(2);
+  filter->SetNumberOfWorkUnits(2);
+  filter->SetBackend("cpu");
   return filter;
 }
 
@@ -220,8 +226,8 @@ TEST(MultiObjectiveMeshRegistrationFilter, RegistersASyntheticBladderAndReportsE
   EXPECT_NEAR(grid->GetSpacing()[0], 2.0, 1e-9);
   for (itk::SizeValueType i = 0; i < filter->GetNumberOfSelectedSolutions(); ++i)
   {
-    const auto * forward = filter->GetFixedToMovingTransform(i);
-    const auto * backward = filter->GetMovingToFixedTransform(i);
+    const auto * forward = filter->GetPreprocessedFixedToMovingTransform(i);
+    const auto * backward = filter->GetPreprocessedMovingToFixedTransform(i);
     ExpectOnGrid(forward, grid);
     ExpectOnGrid(backward, grid);
     // The bladder grows about its centre, so its centre barely moves.
@@ -229,7 +235,15 @@ TEST(MultiObjectiveMeshRegistrationFilter, RegistersASyntheticBladderAndReportsE
     near[0] += 1.0;
     EXPECT_LT(forward->TransformPoint(near).EuclideanDistanceTo(near), 5.0);
     EXPECT_LT(backward->TransformPoint(near).EuclideanDistanceTo(near), 5.0);
+    // Without pre-alignment the original-frame composites map points as the fields do.
+    EXPECT_LT(filter->GetFixedToMovingTransform(i)->TransformPoint(near).EuclideanDistanceTo(forward->TransformPoint(near)),
+              1e-9);
+    EXPECT_LT(
+      filter->GetMovingToFixedTransform(i)->TransformPoint(near).EuclideanDistanceTo(backward->TransformPoint(near)),
+      1e-9);
   }
+  EXPECT_EQ(filter->GetBackendUsed(), "cpu");
+  EXPECT_EQ(filter->GetBackendNote(), "");
 
   // No pre-alignment: the rigid transform is the identity.
   ASSERT_NE(filter->GetRigidTransform(), nullptr);
@@ -347,4 +361,220 @@ TEST(MultiObjectiveMeshRegistrationFilter, ResumesFromItsCheckpoint)
   EXPECT_FALSE(filter->GetApproximationSet().empty());
   EXPECT_EQ(filter->GetNumberOfSelectedSolutions(), 1u);
   std::filesystem::remove(checkpoint);
+}
+
+namespace
+{
+/** A problem whose moving image and masks lie `shift` mm away from where
+ *  the fixed ones are: the rigid pre-alignment on the bones recovers it. */
+struct ShiftedProblem : Problem
+{
+  explicit ShiftedProblem(const itk::Vector<double, 3> & shift)
+  {
+    const auto origin = moving->GetOrigin() + shift;
+    moving->SetOrigin(origin);
+    movingBladder->SetOrigin(origin);
+    movingBones->SetOrigin(origin);
+  }
+};
+
+double
+Dice(const MaskType * a, const MaskType * b)
+{
+  std::size_t both = 0, na = 0, nb = 0;
+  itk::ImageRegionConstIterator<MaskType> ia(a, a->GetLargestPossibleRegion());
+  itk::ImageRegionConstIterator<MaskType> ib(b, b->GetLargestPossibleRegion());
+  for (; !ia.IsAtEnd(); ++ia, ++ib)
+  {
+    na += ia.Get() != 0;
+    nb += ib.Get() != 0;
+    both += ia.Get() != 0 && ib.Get() != 0;
+  }
+  return na + nb ? 2.0 * static_cast<double>(both) / static_cast<double>(na + nb) : 1.0;
+}
+
+/** A mask resampled as the scores resample it: linear interpolation, then inside where >= 0.5. */
+MaskType::Pointer
+ResampleMaskThrough(const MaskType * mask, const itk::ImageBase<3> * grid, const itk::TransformBaseTemplate<double> * t)
+{
+  using ResampleType = itk::ResampleImageFilter<MaskType, ImageType, double>;
+  auto resample = ResampleType::New();
+  resample->SetInput(mask);
+  resample->SetTransform(dynamic_cast<const ResampleType::TransformType *>(t));
+  resample->SetOutputParametersFromImage(grid);
+  resample->SetDefaultPixelValue(0);
+  resample->Update();
+  auto out = MaskType::New();
+  out->CopyInformation(resample->GetOutput());
+  out->SetRegions(resample->GetOutput()->GetLargestPossibleRegion());
+  out->Allocate();
+  itk::ImageRegionConstIterator<ImageType> in(resample->GetOutput(), out->GetLargestPossibleRegion());
+  itk::ImageRegionIterator<MaskType>       o(out, out->GetLargestPossibleRegion());
+  for (; !in.IsAtEnd(); ++in, ++o)
+    o.Set(in.Get() >= 0.5f ? 1 : 0);
+  return out;
+}
+
+itk::PointSet<float, 3>::Pointer
+SurfacePointSet(const MaskType * mask)
+{
+  auto set = itk::PointSet<float, 3>::New();
+  std::size_t i = 0;
+  for (const auto & p : ExtractSurfacePoints(mask))
+  {
+    itk::PointSet<float, 3>::PointType q;
+    for (unsigned d = 0; d < 3; ++d)
+      q[d] = static_cast<float>(p[d]);
+    set->SetPoint(i++, q);
+  }
+  return set;
+}
+
+std::string
+UpdateError(FilterType * filter)
+{
+  try
+  {
+    filter->Update();
+  }
+  catch (const itk::ExceptionObject & e)
+  {
+    return e.GetDescription();
+  }
+  return "(no exception)";
+}
+} // namespace
+
+TEST(MultiObjectiveMeshRegistrationFilter, OriginalFrameTransformsReadBackReproduceTheScores)
+{
+  itk::Vector<double, 3> shift;
+  shift[0] = 4.0;
+  shift[1] = -2.0;
+  shift[2] = 2.0;
+  const ShiftedProblem problem(shift);
+  auto                 filter = MakeFilter(problem);
+  filter->SetParameter("preprocess_rigid_structure", "bones");
+  filter->SetSelection("best-guidance,knee");
+  ASSERT_NO_THROW(filter->Update());
+  // The pre-alignment found the shift.
+  EXPECT_LT(filter->GetRigidTransform()->TransformPoint(BoneCentre()).EuclideanDistanceTo(BoneCentre() + shift), 0.5);
+
+  const auto & run = filter->GetRegistrationRun();
+  const std::string dir = std::string(MOREA_TEST_OUTPUT_DIR) + "/filter_original_frame/";
+  std::filesystem::create_directories(dir);
+  for (itk::SizeValueType i = 0; i < filter->GetNumberOfSelectedSolutions(); ++i)
+  {
+    // What scores.json holds: the scores in the preprocessed frame.
+    const auto & fields = run.selected[i].fields;
+    const auto   scores = EvaluateRegistration(run.preprocessed.problem, fields.fixedToMoving, fields.movingToFixed, 0.0);
+    // The transforms as `morea register` writes them, read back as any ITK program would.
+    WriteSolutionTransforms(run.selected[i].original, dir + "fixed_to_moving.h5", dir + "moving_to_fixed.h5");
+    auto reader = itk::TransformFileReaderTemplate<double>::New();
+    reader->SetFileName(dir + "fixed_to_moving.h5");
+    reader->Update();
+    ASSERT_EQ(reader->GetTransformList()->size(), 1u);
+    const auto * read = reader->GetTransformList()->front().GetPointer();
+    for (const auto & [name, fixedMask, movingMask] :
+         { std::make_tuple("bladder", problem.fixedBladder, problem.movingBladder),
+           std::make_tuple("bones", problem.fixedBones, problem.movingBones) })
+    {
+      const auto warped = ResampleMaskThrough(movingMask, fixedMask, read);
+      const auto fromMemory = ResampleMaskThrough(movingMask, fixedMask, filter->GetFixedToMovingTransform(i));
+      EXPECT_EQ(Dice(warped, fromMemory), 1.0) << name;
+      double inScores = -1.0;
+      for (const auto & s : scores.structures)
+        if (s.name == name)
+          inScores = s.dice;
+      EXPECT_NEAR(Dice(fixedMask, warped), inScores, 0.01) << name << ", solution " << i;
+    }
+  }
+}
+
+TEST(MultiObjectiveMeshRegistrationFilter, ContourPointsAndLandmarksAsPointSets)
+{
+  const Problem problem;
+  auto          filter = MakeFilter(problem);
+  // The moving bladder known by its contour points only (as from an RTSTRUCT).
+  filter->RemoveStructure("bladder");
+  filter->AddStructure("bladder", problem.fixedBladder, nullptr);
+  filter->AddStructurePoints("bladder", nullptr, SurfacePointSet(problem.movingBladder));
+  auto fixedLandmarks = itk::PointSet<float, 3>::New();
+  auto movingLandmarks = itk::PointSet<float, 3>::New();
+  fixedLandmarks->SetPoint(0, BoneCentre());
+  movingLandmarks->SetPoint(0, BoneCentre());
+  fixedLandmarks->SetPoint(1, BladderCentre());
+  movingLandmarks->SetPoint(1, BladderCentre());
+  filter->SetFixedLandmarks(fixedLandmarks);
+  filter->SetMovingLandmarks(movingLandmarks);
+  ASSERT_NO_THROW(filter->Update());
+  const auto & pre = filter->GetRegistrationRun().preprocessed.problem;
+  const auto * bladder = pre.FindStructure("bladder");
+  ASSERT_NE(bladder, nullptr);
+  EXPECT_FALSE(bladder->movingPoints.empty());
+  EXPECT_EQ(pre.fixedLandmarks.size(), 2u);
+  EXPECT_EQ(pre.movingLandmarks.size(), 2u);
+  EXPECT_FALSE(filter->GetApproximationSet().empty());
+}
+
+TEST(MultiObjectiveMeshRegistrationFilter, BadBackendsPointSetsAndKeysThrowClearly)
+{
+  const Problem problem;
+  auto          filter = MakeFilter(problem);
+  EXPECT_THROW(filter->SetBackend("gpu"), itk::ExceptionObject);
+  EXPECT_EQ(filter->GetBackend(), "cpu");
+  {
+    // A device that does not exist, named on purpose: refused for CUDA and auto alike.
+    auto f = MakeFilter(problem);
+    f->SetDevice(63);
+    for (const char * backend : { "cuda", "cuda-exact", "auto" })
+    {
+      f->SetBackend(backend);
+      EXPECT_NE(UpdateError(f).find("CUDA device 63"), std::string::npos) << backend << ": " << UpdateError(f);
+    }
+  }
+  {
+    auto f = MakeFilter(problem);
+    f->AddStructurePoints("rectum", itk::PointSet<float, 3>::New(), SurfacePointSet(problem.movingBones));
+    EXPECT_NE(UpdateError(f).find("the fixed point set is empty"), std::string::npos) << UpdateError(f);
+    EXPECT_THROW(f->AddStructurePoints("rectum", nullptr, nullptr), itk::ExceptionObject);
+  }
+  {
+    auto f = MakeFilter(problem);
+    auto one = itk::PointSet<float, 3>::New();
+    one->SetPoint(0, BoneCentre());
+    f->SetFixedLandmarks(one);
+    f->SetMovingLandmarks(itk::PointSet<float, 3>::New());
+    EXPECT_NE(UpdateError(f).find("landmarks: 1 fixed and 0 moving"), std::string::npos) << UpdateError(f);
+  }
+  for (const auto & [key, value, fragment] : { std::make_tuple("num_runs", "3", "num_runs = 3"),
+                                               std::make_tuple("zip", "true", "zip = true") })
+  {
+    auto f = MakeFilter(problem);
+    f->SetParameter(key, value);
+    EXPECT_NE(UpdateError(f).find(fragment), std::string::npos) << UpdateError(f);
+  }
+}
+
+TEST(MultiObjectiveMeshRegistrationFilter, RunsOnTheGpuByDefaultWhenOneIsPresent)
+{
+  const Problem problem;
+  auto          filter = MakeFilter(problem);
+  filter->SetBackend("auto"); // the default
+  auto fresh = FilterType::New();
+  EXPECT_EQ(fresh->GetBackend(), "auto");
+  ASSERT_NO_THROW(filter->Update());
+  const std::string unavailable = ::morea::CudaUnavailableReason();
+  if (unavailable.empty())
+  {
+    EXPECT_EQ(filter->GetBackendUsed(), "cuda-texture");
+    EXPECT_NE(filter->GetBackendNote().find("texture path"), std::string::npos) << filter->GetBackendNote();
+  }
+  else
+  {
+    EXPECT_EQ(filter->GetBackendUsed(), "cpu");
+    EXPECT_NE(filter->GetBackendNote().find(unavailable), std::string::npos) << filter->GetBackendNote();
+  }
+  std::ostringstream printed;
+  filter->Print(printed);
+  EXPECT_NE(printed.str().find("BackendUsed: " + filter->GetBackendUsed()), std::string::npos) << printed.str();
 }

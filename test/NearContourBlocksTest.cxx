@@ -100,7 +100,7 @@ TEST(NearContourBlocks, NoInterpolatedDistanceBelowTheRadiusFallsInAnUnmarkedBlo
     }
     float values[3];
     volume.Sample(p, values);
-    const std::uint8_t bits = near.mask[near.BlockOf(x)];
+    const std::uint16_t bits = near.mask[near.BlockOf(x)];
     within += std::min(values[1], values[2]) < radius;
     skipped += bits == 0;
     for (int g = 0; g < 2; ++g)
@@ -123,14 +123,19 @@ TEST(NearContourBlocks, NoStructuresMarkNothing)
   EXPECT_EQ(std::count(near.mask.begin(), near.mask.end(), 1), 0);
 }
 
-TEST(NearContourBlocks, AtMostEightStructures)
+TEST(NearContourBlocks, AtMostSixteenStructures)
 {
   ChannelVolume volume;
   volume.size = { { 2, 2, 2 } };
-  volume.channels = 10;
-  volume.data.assign(80, 1.0f);
+  volume.channels = 18;
+  volume.data.assign(8 * 18, 1.0f);
   EXPECT_THROW(FindNearContourBlocks(volume, 3.0), Error);
-  volume.channels = 9;
-  volume.data.assign(72, 1.0f);
-  EXPECT_EQ(FindNearContourBlocks(volume, 3.0).mask[0], 0xff);
+  volume.channels = 17;
+  volume.data.assign(8 * 17, 1.0f);
+  EXPECT_EQ(FindNearContourBlocks(volume, 3.0).mask[0], 0xffff);
+  // Only the structures near a block: the 9th and the 16th here.
+  for (std::size_t v = 0; v < 8; ++v)
+    for (std::size_t g = 0; g < 16; ++g)
+      volume.data[17 * v + 1 + g] = g == 8 || g == 15 ? 1.0f : 10.0f;
+  EXPECT_EQ(FindNearContourBlocks(volume, 3.0).mask[0], 0x8100);
 }

@@ -18,6 +18,8 @@
 
 #include <cmath>
 #include <memory>
+#include <string>
+#include <vector>
 
 namespace morea_test
 {
@@ -84,6 +86,53 @@ struct OptimiserTestProblem
     data.samplingRate = 0.25;
     data.voxelVolume = 1.0;
     evaluator = std::make_unique<morea::TetrahedronEvaluator>(topology, *constraint, elasticity, data);
+  }
+
+  /** `n` guidance structures in place of the ball: structure g is a sphere
+   *  whose centre lies on a ring about the ball's, its radius and weight
+   *  differing with g, so that the contours cross and many places lie near
+   *  several of them. The intensity stays; the evaluator reads the new maps. */
+  void
+  UseStructures(std::size_t n)
+  {
+    const auto rebuild = [n](morea::ChannelVolume & image, const morea::Vec3 & centre, double radius) {
+      const std::size_t    voxels = image.size[0] * image.size[1] * image.size[2];
+      std::vector<float>   out((1 + n) * voxels);
+      const double         pi = 3.14159265358979323846;
+      for (std::size_t v = 0; v < voxels; ++v)
+      {
+        out[(1 + n) * v] = image.data[image.channels * v];
+        const std::size_t i = v % image.size[0], j = v / image.size[0] % image.size[1],
+                          k = v / (image.size[0] * image.size[1]);
+        const morea::Vec3 x{ { image.origin[0] + image.spacing[0] * static_cast<double>(i),
+                               image.origin[1] + image.spacing[1] * static_cast<double>(j),
+                               image.origin[2] + image.spacing[2] * static_cast<double>(k) } };
+        for (std::size_t g = 0; g < n; ++g)
+        {
+          const double angle = 2.0 * pi * static_cast<double>(g) / static_cast<double>(n);
+          const morea::Vec3 c{ { centre[0] + 4.0 * std::cos(angle), centre[1] + 4.0 * std::sin(angle),
+                                 centre[2] + 1.5 * (static_cast<double>(g % 3) - 1.0) } };
+          const double r = std::sqrt((x[0] - c[0]) * (x[0] - c[0]) + (x[1] - c[1]) * (x[1] - c[1]) +
+                                     (x[2] - c[2]) * (x[2] - c[2]));
+          out[(1 + n) * v + 1 + g] = static_cast<float>(std::abs(r - radius * (0.5 + 0.1 * static_cast<double>(g % 5))));
+        }
+      }
+      image.channels = 1 + n;
+      image.data = std::move(out);
+    };
+    rebuild(data.fixed, { { 15.0, 15.0, 15.0 } }, 6.0);
+    rebuild(data.moving, { { 17.0, 15.0, 14.0 } }, 7.5);
+    data.guidanceNames.clear();
+    data.guidanceWeights.clear();
+    double total = 0.0;
+    for (std::size_t g = 0; g < n; ++g)
+    {
+      data.guidanceNames.push_back("sphere" + std::to_string(g));
+      data.guidanceWeights.push_back(1.0 + 0.25 * static_cast<double>(g % 4));
+      total += data.guidanceWeights.back();
+    }
+    for (double & w : data.guidanceWeights)
+      w /= total;
   }
 
   morea::GomeaOptions

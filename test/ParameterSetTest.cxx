@@ -223,7 +223,7 @@ TEST(ParameterSet, ParsesThePaperListingWithVariables)
   EXPECT_EQ(p.GetString("problem_id"), "patient-3");
   EXPECT_EQ(p.GetInteger("num_runs"), 5);
   EXPECT_TRUE(p.GetBool("zip"));
-  EXPECT_EQ(p.GetInteger("cuda_compute_level"), 80); // differs from the default 90
+  EXPECT_EQ(p.GetInteger("cuda_compute_level"), 80);
   EXPECT_EQ(p.GetInteger("cuda_gpu_id"), 0);
   EXPECT_EQ(p.GetInteger("ea_population_size"), 700);
   EXPECT_EQ(p.GetInteger("ea_archive_size"), 2000);

@@ -32,14 +32,14 @@ ListCudaDevices();
 /** Why ListCudaDevices() is empty, or "" when it is not. */
 std::string
 CudaUnavailableReason();
-/** Sets up device 0's CUDA context on a thread of its own while the caller
- *  goes on (reading and preprocessing images), so that a CUDA backend made
- *  later does not wait for it; waits for that thread when destroyed. Errors
- *  are left for the backend to report. Does nothing without CUDA. */
+/** Sets up device `device`'s CUDA context on a thread of its own while the
+ *  caller goes on (reading and preprocessing images), so that a CUDA backend
+ *  made later does not wait for it; waits for that thread when destroyed.
+ *  Errors are left for the backend to report. Does nothing without CUDA. */
 class CudaContextWarmUp
 {
 public:
-  CudaContextWarmUp();
+  explicit CudaContextWarmUp(int device = 0);
   ~CudaContextWarmUp();
   CudaContextWarmUp(const CudaContextWarmUp &) = delete;
   CudaContextWarmUp &

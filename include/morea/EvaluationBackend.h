@@ -172,9 +172,18 @@ public:
     return m_Statistics;
   }
 
-  /** "cpu" or "cuda". */
+  /** "cpu", "cuda" or "cuda-texture": the path that runs. */
   virtual std::string
   Name() const = 0;
+
+  /** "" when the path asked for runs; else one sentence naming the path
+   *  used instead and why (e.g. the CUDA texture path asked for with more
+   *  guidance structures than it reads), for logs and reports. */
+  virtual std::string
+  PathNote() const
+  {
+    return {};
+  }
 
   /** Per-tetrahedron values of whole solutions: values[i] gets one entry per
    *  tetrahedron of solutions[i]. */
@@ -356,35 +365,68 @@ CheckCandidateFolds(const PartialCandidate & candidate, const FoldHandling & han
 std::unique_ptr<EvaluationBackend>
 CreateCpuEvaluationBackend(const TetrahedronEvaluator & evaluator, std::size_t threads = 0);
 
-/** How the CUDA backend interpolates images with at most 4 channels. */
+/** How the CUDA backend interpolates the images (Texture: for at most
+ *  cuda::MaxTextureStructures guidance structures; with more, Exact). */
 enum class CudaInterpolation
 {
   Exact,  ///< software trilinear: agrees with the CPU backend to rounding (the default)
   Texture ///< the texture units' filtering (9-bit weights): faster, agrees less closely
 };
 
-/** The CUDA backend on device 0 (`threads` host threads pack and unpack the
- *  batches). Throws morea::Error when the build has no CUDA or no device is
- *  present, and names out-of-memory as such. */
+/** The CUDA backend on device `device` (`threads` host threads pack and
+ *  unpack the batches). Throws morea::Error when the build has no CUDA, no
+ *  such device is present, and names out-of-memory as such. */
 std::unique_ptr<EvaluationBackend>
 CreateCudaEvaluationBackend(const TetrahedronEvaluator & evaluator, std::size_t threads = 0,
-                            CudaInterpolation interpolation = CudaInterpolation::Exact);
+                            CudaInterpolation interpolation = CudaInterpolation::Exact, int device = 0);
 
 enum class BackendChoice
 {
   Cpu,
-  Cuda,        ///< exact (software) trilinear interpolation, as the CPU
-  CudaTexture, ///< hardware-filtered interpolation: faster, within about 1e-4 of the CPU
-  Auto         ///< CUDA (exact) when a device is present, else the CPU
+  CudaTexture, ///< "cuda": hardware-filtered interpolation, the fast path; within about 1e-4 of the CPU
+  CudaExact,   ///< "cuda-exact": software trilinear interpolation as on the CPU, for verification
+  Auto         ///< the texture path when a usable device is present, else the CPU
 };
 
-/** "cpu", "cuda", "cuda-texture" or "auto"; anything else is an error. */
+/** "cpu", "cuda" (also "cuda-texture"), "cuda-exact" or "auto"; anything
+ *  else is an error naming the choices. */
 BackendChoice
 ParseBackendChoice(const std::string & name);
 
-/** The one place that picks the platform. */
+/** The name ParseBackendChoice reads back ("cpu", "cuda", "cuda-exact", "auto"). */
+std::string
+BackendChoiceName(BackendChoice choice);
+
+/** Where a registration's evaluations run. */
+struct BackendRequest
+{
+  BackendChoice choice{ BackendChoice::Auto };
+  int           device{ 0 };  ///< CUDA device ordinal
+  /** Lowest compute capability (major x 10 + minor) a device must have. */
+  int           minimumComputeLevel{ 0 };
+  std::size_t   threads{ 0 }; ///< host threads; 0: all
+};
+
+/** Why `request` runs where it does, found before any backend is made: ""
+ *  when the device asked for by name is usable; for Auto, which platform it
+ *  picks and why. Throws morea::Error when a CUDA backend asked for by name
+ *  cannot be used (no CUDA in the build, no device, device index out of
+ *  range, compute capability below the minimum). */
+std::string
+CheckBackendRequest(const BackendRequest & request, BackendChoice * resolved = nullptr);
+
+/** The one place that picks the platform. Auto: the texture path on the
+ *  requested device when it is usable, else the CPU. */
 std::unique_ptr<EvaluationBackend>
-CreateEvaluationBackend(BackendChoice choice, const TetrahedronEvaluator & evaluator, std::size_t threads = 0);
+CreateEvaluationBackend(BackendChoice choice, const TetrahedronEvaluator & evaluator, std::size_t threads = 0,
+                        int device = 0);
+
+/** CreateEvaluationBackend for a request; `note` (may be null) gets why it
+ *  runs where it does: the platform Auto picked and any path the backend
+ *  could not take (EvaluationBackend::PathNote). */
+std::unique_ptr<EvaluationBackend>
+CreateEvaluationBackend(const BackendRequest & request, const TetrahedronEvaluator & evaluator,
+                        std::string * note = nullptr);
 
 /** Whether a run on `backend` skips candidates by their bound. */
 inline bool

@@ -23,9 +23,12 @@ struct NearContourBlocks
   static constexpr int BlockSize = 4;
 
   std::array<int, 3>        blocks{ { 0, 0, 0 } }; ///< per axis, ceil(size / BlockSize)
+  /** Structures a mask holds (a bit each). */
+  static constexpr int MaxStructures = 16;
+
   /** Per block, x fastest: bit g set where structure g may be near (0:
    *  near none). */
-  std::vector<std::uint8_t> mask;
+  std::vector<std::uint16_t> mask;
 
   /** The block of continuous voxel index `x` (voxel centres at integers):
    *  the one holding the first voxel of its trilinear footprint, floor(x),
@@ -46,13 +49,13 @@ struct NearContourBlocks
 };
 
 /** Marks each block of `volume` (channel 0 the intensity, then one distance
- *  map per structure, in mm; at most 8 structures) with bit g where any
+ *  map per structure, in mm; at most MaxStructures) with bit g where any
  *  voxel that a trilinear sample starting in the block reads, [BlockSize b,
  *  BlockSize b + BlockSize] per axis, has a distance to structure g below
  *  `radius` (plus a margin for rounding). An interpolated distance is never
  *  below the smallest of its voxels, so a sample in a block without bit g is
- *  at least `radius` from structure g's contour. Throws for more than 8
- *  structures. */
+ *  at least `radius` from structure g's contour. Throws for more than
+ *  MaxStructures structures. */
 NearContourBlocks
 FindNearContourBlocks(const ChannelVolume & volume, double radius);
 } // namespace morea

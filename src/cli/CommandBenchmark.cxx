@@ -193,7 +193,7 @@ AddBenchmarkCommand(CLI::App & app)
   options->problem.AddTo(*cmd);
   options->parameters.AddTo(*cmd);
   cmd->add_option("-o,--output", options->output, "JSON file for the results")->required();
-  cmd->add_option("--backends", options->backends, "comma-separated: cuda, cuda-texture, cpu")->capture_default_str();
+  cmd->add_option("--backends", options->backends, "comma-separated: cuda (the texture path; also cuda-texture), cuda-exact, cpu")->capture_default_str();
   cmd->add_option("--generations", options->generations, "generations of the CUDA run (0: ea_num_generations)")
     ->capture_default_str();
   cmd->add_option("--cpu-generations", options->cpuGenerations, "generations of the CPU run (the same first ones)")

@@ -4,7 +4,7 @@
 #include "CommandCommon.h"
 #include "RegistrationOutputs.h"
 
-#include "itkMeshRegistration.h"
+#include "FilterRun.h"
 
 #include "itkImageRegionIteratorWithIndex.h"
 #include "itkMOREAImageIO.h"
@@ -104,12 +104,24 @@ AddDemoCommand(CLI::App & app)
     ProblemOptions load;
     load.folder = (root / "phantom").string();
     const auto input = load.Load();
-    const auto result = Preprocess(input, PreprocessOptions::FromParameters(parameters));
+    std::cout << "2. registering with MOREA (" << parameters.GetInteger("ea_num_generations") << " generations, population "
+              << parameters.GetInteger("ea_population_size") << ", " << parameters.GetInteger("morea_mesh_num_points")
+              << " mesh points)\n";
+    FilterSettings settings;
+    settings.refusalBounds = options->refusalBound;
+    settings.onGeneration = ProgressPrinter();
+    const auto filter = MakeRegistrationFilter(input, parameters, settings);
+    UpdateRegistrationFilter(*filter);
+    const auto & run = filter->GetRegistrationRun();
+    const auto & result = run.preprocessed;
+    const auto & r = result.report;
+    std::cout << "3. preprocessed: " << r.size[0] << "x" << r.size[1] << "x" << r.size[2] << " voxels of " << r.spacing
+              << " mm around '" << r.cropStructure << "', rigid on '" << r.rigidStructure << "'; evaluated on the "
+              << run.registration.backend
+              << (run.registration.backendNote.empty() ? "" : " backend (" + run.registration.backendNote + ")")
+              << "\n";
     WriteProblemFolder(result.problem, (root / "preprocessed").string());
     WriteRigidTransform(result.rigidTransform, (root / "preprocessed" / "rigid_fixed_to_moving.tfm").string());
-    const auto & r = result.report;
-    std::cout << "2. preprocessed: " << r.size[0] << "x" << r.size[1] << "x" << r.size[2] << " voxels of " << r.spacing
-              << " mm around '" << r.cropStructure << "', rigid on '" << r.rigidStructure << "'\n";
 
     const double margin = parameters.GetReal("evaluation_border_margin");
     const auto   baseline = EvaluateRegistration(result.problem, nullptr, nullptr, margin);
@@ -118,21 +130,13 @@ AddDemoCommand(CLI::App & app)
     const auto   truth = EvaluateRegistration(result.problem, forward, inverse, margin);
     WriteDisplacementField(forward, (root / "preprocessed_true_fixed_to_moving.nii.gz").string());
     WriteDisplacementField(inverse, (root / "preprocessed_true_moving_to_fixed.nii.gz").string());
-    std::cout << "3. registering with MOREA (" << parameters.GetInteger("ea_num_generations") << " generations, population "
-              << parameters.GetInteger("ea_population_size") << ", " << parameters.GetInteger("morea_mesh_num_points")
-              << " mesh points)\n";
-    itk::morea::MeshRegistrationOptions run;
-    run.onGeneration = ProgressPrinter();
-    run.refusalBounds = ::morea::ParseRefusalBoundChoice(options->refusalBound);
-    const auto registration = RegisterMeshes(result.problem, parameters, run);
-    const auto chosen = ChooseSolutions(registration.front, "best-guidance,knee");
-    const auto summary =
-      WriteRegistrationOutputs(result, registration, chosen, margin, (root / "registration").string(), forward);
+    const auto summary = WriteRegistrationOutputs(run, parameters, (root / "registration").string(), forward);
 
     std::cout << "4. evaluation\n";
     PrintScores(std::cout, baseline, "   baseline after rigid pre-alignment");
-    for (const auto & c : chosen)
+    for (const auto & selected : run.selected)
     {
+      const auto & c = selected.choice;
       const auto & entry = summary["solutions"][c.label];
       std::cout << "   MOREA " << c.label << " solution: mean displacement error in the body "
                 << entry["mean_displacement_error_in_body_mm"].get<double>() << " mm\n";

@@ -3,14 +3,11 @@
 #include "CommandCommon.h"
 #include "RegistrationOutputs.h"
 
+#include "FilterRun.h"
+#include "ZipArchive.h"
+
 #include "itkMOREAImageIO.h"
-#include "itkMeshRegistration.h"
-#include "itkMultiObjectiveMeshRegistrationFilterSupport.h"
-#include "itkPreprocessing.h"
-#include "itkRigidPreAlignment.h"
 #include "morea/ComputeDevices.h"
-#include "morea/Error.h"
-#include "morea/EvaluationBackend.h"
 
 #include <chrono>
 #include <csignal>
@@ -21,22 +18,102 @@
 
 namespace morea::cli
 {
+namespace
+{
+struct Options
+{
+  ProblemOptions             problem;
+  ParameterOptions           parameters;
+  std::string                output;
+  std::string                select{ "best-guidance,knee" };
+  std::size_t                checkpointEvery{ 10 };
+  bool                       resume{ false };
+  std::size_t                threads{ 0 };
+  std::string                backend{ "auto" };
+  std::optional<std::size_t> device;
+  std::size_t                killAfter{ 0 };
+  std::string                refusalBound{ "auto" };
+};
+
+/** One registration through the filter, its folder written and its scores printed. */
+void
+RegisterOnce(const itk::morea::RegistrationProblem & input, const ParameterSet & parameters, const Options & options,
+             const std::string & folder, const CommandTimes & times)
+{
+  const bool createdFolder = std::filesystem::create_directories(folder);
+  FilterSettings settings;
+  settings.backend = options.backend;
+  settings.threads = options.threads;
+  settings.refusalBounds = options.refusalBound;
+  settings.selection = options.select;
+  settings.checkpointFile = folder + "/checkpoint.bin";
+  settings.checkpointInterval = options.checkpointEvery;
+  settings.resume = options.resume;
+  settings.onGeneration = [print = ProgressPrinter(), killAfter = options.killAfter](
+                            const ::morea::GenerationRecord & r, std::size_t total) {
+    print(r, total);
+    if (killAfter > 0 && r.generation == killAfter)
+      std::raise(SIGKILL);
+  };
+  const auto filter = MakeRegistrationFilter(input, parameters, settings);
+  try
+  {
+    UpdateRegistrationFilter(*filter);
+  }
+  catch (...)
+  {
+    // A run that failed before its first checkpoint leaves no folder behind.
+    std::error_code ec;
+    if (createdFolder && std::filesystem::is_empty(folder, ec))
+      std::filesystem::remove(folder, ec);
+    throw;
+  }
+  const auto & run = filter->GetRegistrationRun();
+  const auto & r = run.preprocessed.report;
+  const auto & result = run.registration;
+  std::cout << "preprocessed: " << r.size[0] << "x" << r.size[1] << "x" << r.size[2] << " voxels of " << r.spacing
+            << " mm around '" << r.cropStructure << "'"
+            << (r.rigidStructure.empty() ? std::string() : ", rigid on '" + r.rigidStructure + "'") << "\n";
+  if (!r.rigid.intensitySkipped.empty())
+    std::cout << "note: rigid pre-alignment without its intensity stage: " << r.rigid.intensitySkipped << "\n";
+  if (result.resumedAtGeneration > 0)
+    std::cout << "resumed from generation " << result.resumedAtGeneration << "\n";
+  std::cout << "backend: " << result.backend << (result.backendNote.empty() ? "" : " (" + result.backendNote + ")")
+            << "\n";
+  if (!result.pathNote.empty())
+    std::cout << "warning: " << result.pathNote << "\n";
+  std::cout << "mesh " << result.model.base.NumberOfPoints() << " points, " << result.model.base.NumberOfTetrahedra()
+            << " tetrahedra (" << result.secondsModel << " s); optimisation " << result.secondsOptimisation
+            << " s on the " << result.backend << " backend (" << result.threads << " threads); front of "
+            << result.front.size() << "\n";
+
+  const auto summary = WriteRegistrationOutputs(run, parameters, folder, nullptr, &times);
+  for (const auto & selected : run.selected)
+  {
+    const auto & c = selected.choice;
+    const auto & s = result.front[c.index];
+    std::cout << c.label << ": id " << s.id << ", magnitude " << s.fitness.objectives[0] << ", intensity "
+              << s.fitness.objectives[1] << ", guidance " << s.fitness.objectives[2] << "\n";
+    if (summary.contains("solutions") && summary["solutions"][c.label].contains("scores"))
+      for (const auto & [name, v] : summary["solutions"][c.label]["scores"]["structures"].items())
+        std::cout << "  " << name << ": Dice " << v["dice"].get<double>() << " (rigid "
+                  << summary["rigid_baseline"]["structures"][name]["dice"].get<double>() << "), HD95 "
+                  << v["hausdorff95_mm"].get<double>() << " mm (rigid "
+                  << summary["rigid_baseline"]["structures"][name]["hausdorff95_mm"].get<double>() << ")\n";
+  }
+  const auto & seconds = summary["seconds"];
+  std::cout << "times: load " << seconds["load"].get<double>() << " s, preprocessing "
+            << seconds["preprocessing"].get<double>() << " s, model " << seconds["model"].get<double>()
+            << " s, optimisation " << seconds["optimisation"].get<double>() << " s, outputs "
+            << seconds["fields"].get<double>() + seconds["outputs"].get<double>() << " s, command "
+            << seconds["command"].get<double>() << " s\n";
+  std::cout << "written to " << folder << "\n";
+}
+} // namespace
+
 void
 AddRegisterCommand(CLI::App & app)
 {
-  struct Options
-  {
-    ProblemOptions   problem;
-    ParameterOptions parameters;
-    std::string      output;
-    std::string      select{ "best-guidance,knee" };
-    std::size_t      checkpointEvery{ 10 };
-    bool             resume{ false };
-    std::size_t      threads{ 0 };
-    std::string      backend{ "auto" };
-    std::size_t      killAfter{ 0 };
-    std::string      refusalBound{ "auto" };
-  };
   auto   options = std::make_shared<Options>();
   auto * cmd = app.add_subcommand("register", "register a problem with MOREA and write the approximation set");
   options->problem.AddTo(*cmd);
@@ -49,12 +126,14 @@ AddRegisterCommand(CLI::App & app)
                   "write output/checkpoint.bin every N generations (0: only at the end)")
     ->capture_default_str();
   cmd->add_flag("--resume", options->resume, "continue from output/checkpoint.bin when it exists");
-  cmd->add_option("--threads", options->threads, "CPU threads (0: all)")->capture_default_str();
+  cmd->add_option("--threads", options->threads, "host threads (0: all)")->capture_default_str();
   cmd->add_option("--backend", options->backend,
-                  "evaluation backend: cpu, cuda, cuda-texture (hardware interpolation, faster), or auto (cuda when "
-                  "a device is present)")
-    ->check(CLI::IsMember({ "cpu", "cuda", "cuda-texture", "auto" }))
+                  "where solutions are evaluated: auto (the GPU's texture path when a usable CUDA device is present, "
+                  "else the CPU), cuda (the texture path), cuda-exact (software interpolation on the GPU, for "
+                  "verification) or cpu")
+    ->check(CLI::IsMember({ "auto", "cuda", "cuda-texture", "cuda-exact", "cpu" }))
     ->capture_default_str();
+  cmd->add_option("--device", options->device, "CUDA device ordinal (sets cuda_gpu_id)");
   cmd->add_option("--refusal-bound", options->refusalBound,
                   "skip sampling candidates that a lower bound of their objectives shows refused: on, off, or auto "
                   "(on with the cpu backend; the same result either way)")
@@ -67,80 +146,43 @@ AddRegisterCommand(CLI::App & app)
     namespace fs = std::filesystem;
     using Clock = std::chrono::steady_clock;
     const auto started = Clock::now();
+    auto       parameters = options->parameters.Load();
+    if (options->device)
+      parameters.SetFromString("cuda_gpu_id", std::to_string(*options->device));
     // The device's context is made while the problem is read and preprocessed.
     std::optional<::morea::CudaContextWarmUp> warmUp;
     if (options->backend != "cpu")
-      warmUp.emplace();
-    auto       secondsSince = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
-    const auto parameters = options->parameters.Load();
+      warmUp.emplace(static_cast<int>(parameters.GetInteger("cuda_gpu_id")));
     itk::morea::CheckSolutionSelection(options->select); // before a long run, not after
-    const auto input = options->problem.Load();
-    const double secondsLoad = secondsSince(started);
-    auto         stage = Clock::now();
-    const auto preprocessed = itk::morea::Preprocess(input, itk::morea::PreprocessOptions::FromParameters(parameters));
-    const double secondsPreprocess = secondsSince(stage);
-    const auto & r = preprocessed.report;
-    std::cout << "preprocessed: " << r.size[0] << "x" << r.size[1] << "x" << r.size[2] << " voxels of " << r.spacing
-              << " mm around '" << r.cropStructure << "'"
-              << (r.rigidStructure.empty() ? std::string() : ", rigid on '" + r.rigidStructure + "'") << "\n";
-    // A CUDA backend asked for by name but unusable: said before any output
-    // is written (the context warm-up has long finished by now, so this
-    // costs the run nothing).
-    const ::morea::BackendChoice backend = ::morea::ParseBackendChoice(options->backend);
-    if (backend == ::morea::BackendChoice::Cuda || backend == ::morea::BackendChoice::CudaTexture)
-      if (const std::string reason = ::morea::CudaUnavailableReason(); !reason.empty())
-        throw ::morea::Error("CUDA backend: " + reason + " (--backend auto falls back to the CPU)");
-    fs::create_directories(options->output);
-    const std::string out = options->output + "/";
-    itk::morea::WriteTextFile(parameters.ToToml(), out + "parameters.toml");
-    itk::morea::WriteRigidTransform(preprocessed.rigidTransform, out + "rigid_fixed_to_moving.tfm");
+    const auto   input = options->problem.Load();
+    const double secondsLoad = std::chrono::duration<double>(Clock::now() - started).count();
 
-    itk::morea::MeshRegistrationOptions run;
-    run.checkpointPath = out + "checkpoint.bin";
-    run.checkpointInterval = options->checkpointEvery;
-    run.resume = options->resume;
-    run.threads = options->threads;
-    run.backend = backend;
-    run.refusalBounds = ::morea::ParseRefusalBoundChoice(options->refusalBound);
-    run.onGeneration = [print = ProgressPrinter(), killAfter = options->killAfter](
-                         const ::morea::GenerationRecord & r, std::size_t total) {
-      print(r, total);
-      if (killAfter > 0 && r.generation == killAfter)
-        std::raise(SIGKILL);
-    };
-    stage = Clock::now();
-    const auto result = itk::morea::RegisterMeshes(preprocessed.problem, parameters, run);
-    const double secondsRegister = secondsSince(stage);
-    if (result.resumedAtGeneration > 0)
-      std::cout << "resumed from generation " << result.resumedAtGeneration << "\n";
-    std::cout << "mesh " << result.model.base.NumberOfPoints() << " points, " << result.model.base.NumberOfTetrahedra()
-              << " tetrahedra (" << result.secondsModel << " s); optimisation " << result.secondsOptimisation
-              << " s on the " << result.backend << " backend (" << result.threads << " threads); front of " << result.front.size()
-              << "\n";
-
-    const auto chosen = ChooseSolutions(result.front, options->select);
-    const CommandTimes times{ started, secondsLoad, secondsPreprocess, secondsRegister };
-    const auto summary = WriteRegistrationOutputs(preprocessed, result, chosen,
-                                                  parameters.GetReal("evaluation_border_margin"), options->output,
-                                                  nullptr, &times);
-    for (const auto & c : chosen)
+    // num_runs registrations with consecutive seeds, each in a folder of its
+    // own when there are several; zip = true archives the output folder.
+    const auto runs = parameters.GetInteger("num_runs");
+    const bool zip = parameters.GetBool("zip");
+    if (runs > 1)
     {
-      const auto & s = result.front[c.index];
-      std::cout << c.label << ": id " << s.id << ", magnitude " << s.fitness.objectives[0] << ", intensity "
-                << s.fitness.objectives[1] << ", guidance " << s.fitness.objectives[2] << "\n";
-      if (summary.contains("solutions") && summary["solutions"][c.label].contains("scores"))
-        for (const auto & [name, v] : summary["solutions"][c.label]["scores"]["structures"].items())
-          std::cout << "  " << name << ": Dice " << v["dice"].get<double>() << " (rigid "
-                    << summary["rigid_baseline"]["structures"][name]["dice"].get<double>() << "), HD95 "
-                    << v["hausdorff95_mm"].get<double>() << " mm (rigid "
-                    << summary["rigid_baseline"]["structures"][name]["hausdorff95_mm"].get<double>() << ")\n";
+      fs::create_directories(options->output);
+      itk::morea::WriteTextFile(parameters.ToToml(), options->output + "/parameters.toml");
     }
-    const auto & seconds = summary["seconds"];
-    std::cout << "times: load " << seconds["load"].get<double>() << " s, preprocessing "
-              << seconds["preprocessing"].get<double>() << " s, model " << seconds["model"].get<double>()
-              << " s, optimisation " << seconds["optimisation"].get<double>() << " s, outputs "
-              << seconds["outputs"].get<double>() << " s, command " << seconds["command"].get<double>() << " s\n";
-    std::cout << "written to " << options->output << "\n";
+    for (std::int64_t k = 0; k < runs; ++k)
+    {
+      ParameterSet run = parameters;
+      run.SetFromString("num_runs", "1");
+      run.SetFromString("zip", "false");
+      run.SetFromString("seed", std::to_string(parameters.GetInteger("seed") + k));
+      const std::string folder = runs > 1 ? options->output + "/run_" + std::to_string(k + 1) : options->output;
+      if (runs > 1)
+        std::cout << "run " << k + 1 << " of " << runs << " (seed " << run.GetInteger("seed") << ") in " << folder
+                  << "\n";
+      RegisterOnce(input, run, *options, folder, { started, secondsLoad });
+    }
+    if (zip)
+    {
+      const std::string archive = ZipFolder(options->output);
+      std::cout << "archived to " << archive << "\n";
+    }
   });
 }
 } // namespace morea::cli

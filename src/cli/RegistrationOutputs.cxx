@@ -111,17 +111,6 @@ private:
 };
 } // namespace
 
-std::vector<ChosenSolution>
-ChooseSolutions(const std::vector<itk::morea::FrontSolution> & front, const std::string & selection)
-{
-  if (front.empty())
-    throw ::morea::Error("the approximation set is empty: no fold-free solution was found");
-  std::vector<ChosenSolution> chosen;
-  for (const auto & c : itk::morea::SelectSolutions(itk::morea::ToApproximationSet(front), selection))
-    chosen.push_back({ c.label, c.index });
-  return chosen;
-}
-
 std::function<void(const ::morea::GenerationRecord &, std::size_t)>
 ProgressPrinter()
 {
@@ -155,25 +144,31 @@ ProgressPrinter()
 }
 
 nlohmann::json
-WriteRegistrationOutputs(const itk::morea::PreprocessResult & preprocessed,
-                         const itk::morea::MeshRegistrationResult & result,
-                         const std::vector<ChosenSolution> & chosen, double borderMargin, const std::string & folder,
-                         const itk::morea::DisplacementFieldType * trueFixedToMoving, const CommandTimes * times)
+WriteRegistrationOutputs(const itk::morea::MultiObjectiveRegistrationRun & run, const ParameterSet & parameters,
+                         const std::string & folder, const itk::morea::DisplacementFieldType * trueFixedToMoving,
+                         const CommandTimes * times)
 {
   using namespace itk::morea;
   namespace fs = std::filesystem;
   using Clock = std::chrono::steady_clock;
   const auto outputsStarted = Clock::now();
   // Seconds of the outputs' parts, summed over the chosen solutions.
-  double fieldSeconds = 0.0, fileSeconds = 0.0, scoreSeconds = 0.0, renderSeconds = 0.0;
+  double fileSeconds = 0.0, scoreSeconds = 0.0, renderSeconds = 0.0;
   auto   lap = [last = Clock::now()](double & into) mutable {
     const auto now = Clock::now();
     into += std::chrono::duration<double>(now - last).count();
     last = now;
   };
+  const auto & preprocessed = run.preprocessed;
+  const auto & result = run.registration;
   const auto & problem = preprocessed.problem;
+  const double borderMargin = parameters.GetReal("evaluation_border_margin");
   fs::create_directories(folder);
   const std::string out = folder + "/";
+  // A completed earlier run's summary must not stand beside this run's files.
+  fs::remove(out + "summary.json");
+  WriteTextFile(parameters.ToToml(), out + "parameters.toml");
+  WriteRigidTransform(preprocessed.rigidTransform, out + "rigid_fixed_to_moving.tfm");
 
   // The front.
   std::ostringstream csv;
@@ -184,9 +179,9 @@ WriteRegistrationOutputs(const itk::morea::PreprocessResult & preprocessed,
   {
     const auto & s = result.front[i];
     std::string  labels;
-    for (const auto & c : chosen)
-      if (c.index == i)
-        labels += (labels.empty() ? "" : ";") + c.label;
+    for (const auto & c : run.selected)
+      if (c.choice.index == i)
+        labels += (labels.empty() ? "" : ";") + c.choice.label;
     csv << s.id << "," << s.fitness.objectives[0] << "," << s.fitness.objectives[1] << "," << s.fitness.objectives[2]
         << "," << s.fitness.constraint << "," << labels << "\n";
     front.push_back({ { "id", s.id },
@@ -224,41 +219,24 @@ WriteRegistrationOutputs(const itk::morea::PreprocessResult & preprocessed,
   nlohmann::json   summary;
   BackgroundWrites writes;
   lap(fileSeconds);
-  auto rasterize = [&](std::size_t i) {
-    return RasterizeSolution(result.model.topology, result.front[chosen[i].index].mesh, problem.fixedImage,
-                             problem.movingImage);
-  };
-  // The rigid baseline's scores while the first solutions' fields, transforms
-  // and meshes are made (they read the images' grids only); waited for before
-  // the solutions' own scores, so that no two pipelines share a mask.
+  // The rigid baseline's scores while the first solutions' files are written
+  // (they read the images' grids only); waited for before the solutions' own
+  // scores, so that no two pipelines share a mask.
   std::future<EvaluationScores> baseline;
   if (scored)
     baseline = std::async(std::launch::async,
                           [&problem, borderMargin] { return EvaluateRegistration(problem, nullptr, nullptr, borderMargin); });
-  // Each solution's fields are made one solution ahead, on a thread of their
-  // own (the first two side by side), so that its slow .nii.gz writes start
-  // before the last solution's transforms, scores and renders rather than
-  // after them; at most two solutions' fields are held. (A rasterisation
-  // keeps two cores busy; on a 16-core H100 host the two chosen solutions'
-  // fields took 0.47-0.62 s against 0.74-0.85 s one after the other.)
-  const auto rasterizeLater = [&](std::size_t i) { return std::async(std::launch::async, rasterize, i); };
-  std::future<MeshFields> next;
-  if (chosen.size() > 1)
-    next = rasterizeLater(1);
-  for (std::size_t i = 0; i < chosen.size(); ++i)
+  for (const auto & selected : run.selected)
   {
-    const auto &      c = chosen[i];
+    const auto &      c = selected.choice;
+    const auto &      fields = selected.fields;
     const auto &      s = result.front[c.index];
     const std::string dir = out + c.label + "/";
     fs::create_directories(dir);
-    const MeshFields fields = i == 0 ? rasterize(0) : next.get();
-    if (i > 0 && i + 1 < chosen.size())
-      next = rasterizeLater(i + 1);
-    lap(fieldSeconds);
     for (const auto & [field, name] : { std::make_pair(fields.fixedToMoving, "preprocessed_fixed_to_moving.nii.gz"),
                                         std::make_pair(fields.movingToFixed, "preprocessed_moving_to_fixed.nii.gz") })
       writes.Add([view = SharingBuffer(field), path = dir + name] { WriteDisplacementField(view, path); });
-    WriteSolutionTransforms(fields, preprocessed.rigidTransform, dir + "fixed_to_moving.h5", dir + "moving_to_fixed.h5");
+    WriteSolutionTransforms(selected.original, dir + "fixed_to_moving.h5", dir + "moving_to_fixed.h5");
     WriteSolutionMeshes(result.model, s.mesh, dir + "mesh_moving.vtu", dir + "mesh_fixed.vtu");
     lap(fileSeconds);
     nlohmann::json entry = { { "id", s.id },
@@ -293,26 +271,30 @@ WriteRegistrationOutputs(const itk::morea::PreprocessResult & preprocessed,
   lap(scoreSeconds);
   writes.Wait();
   lap(fileSeconds);
+  summary["problem_id"] = parameters.GetString("problem_id");
+  summary["sweep_descriptor"] = parameters.GetString("sweep_descriptor");
+  summary["seed"] = parameters.GetInteger("seed");
+  summary["backend_note"] = result.backendNote;
+  summary["backend_path_note"] = result.pathNote;
   summary["front_size"] = result.front.size();
   summary["generations"] = result.history.empty() ? 0 : result.history.back().generation;
   summary["backend"] = result.backend;
   summary["threads"] = result.threads;
-  summary["seconds"] = { { "model", result.secondsModel }, { "optimisation", result.secondsOptimisation } };
+  summary["seconds"] = { { "preprocessing", run.secondsPreprocessing },
+                         { "model", result.secondsModel },
+                         { "optimisation", result.secondsOptimisation },
+                         { "fields", run.secondsSelection } };
+  auto & seconds = summary["seconds"];
+  seconds["model_parts"] = { { "mesh", result.secondsMesh },
+                             { "objective_data", result.secondsObjectiveData },
+                             { "backend", result.secondsBackend } };
+  seconds["registration_other"] = run.secondsRegistration - result.secondsModel - result.secondsOptimisation;
+  seconds["outputs"] = std::chrono::duration<double>(Clock::now() - outputsStarted).count();
+  seconds["outputs_parts"] = { { "files", fileSeconds }, { "scores", scoreSeconds }, { "renders", renderSeconds } };
   if (times)
   {
     // summary.json's own writing is the only part left out.
-    auto & seconds = summary["seconds"];
     seconds["load"] = times->load;
-    seconds["preprocessing"] = times->preprocessing;
-    seconds["model_parts"] = { { "mesh", result.secondsMesh },
-                               { "objective_data", result.secondsObjectiveData },
-                               { "backend", result.secondsBackend } };
-    seconds["registration_other"] = times->registration - result.secondsModel - result.secondsOptimisation;
-    seconds["outputs"] = std::chrono::duration<double>(Clock::now() - outputsStarted).count();
-    seconds["outputs_parts"] = { { "fields", fieldSeconds },
-                                 { "files", fileSeconds },
-                                 { "scores", scoreSeconds },
-                                 { "renders", renderSeconds } };
     seconds["command"] = std::chrono::duration<double>(Clock::now() - times->started).count();
   }
   WriteJson(summary, out + "summary.json");

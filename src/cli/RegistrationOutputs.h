@@ -4,8 +4,7 @@
 
 #include "CommandCommon.h"
 
-#include "itkMeshRegistration.h"
-#include "itkPreprocessing.h"
+#include "itkMultiObjectiveMeshRegistrationFilterSupport.h"
 
 #include <chrono>
 #include <string>
@@ -13,41 +12,29 @@
 
 namespace morea::cli
 {
-/** A chosen solution of the front and why it was chosen. */
-struct ChosenSolution
-{
-  std::string label; ///< "best_guidance", "knee", ...
-  std::size_t index{ 0 }; ///< into the front
-};
-
 /** Where a command's time went before its outputs (`morea register`). */
 struct CommandTimes
 {
   std::chrono::steady_clock::time_point started; ///< the command's start
-  double                                load{ 0.0 };          ///< reading the problem
-  double                                preprocessing{ 0.0 }; ///< resampling, pre-alignment, cropping
-  double                                registration{ 0.0 };  ///< model and optimisation (RegisterMeshes)
+  double                                load{ 0.0 }; ///< reading the problem
 };
-
-/** Parses "best-guidance,knee,weighted:1:1:2,nearest:m:i:g,all" into front indices. */
-std::vector<ChosenSolution>
-ChooseSolutions(const std::vector<itk::morea::FrontSolution> & front, const std::string & selection);
 
 /** A terminal progress line per generation (a bar on a terminal, every 10th
  *  generation otherwise). */
 std::function<void(const ::morea::GenerationRecord &, std::size_t)>
 ProgressPrinter();
 
-/** Writes front.csv, front.json, generations.csv and, per chosen solution, a
- *  folder with both fields (NIfTI, preprocessed frame), both transforms (.h5,
- *  original images' space), both meshes (.vtu) and, when the fixed structures
- *  are known, scores.json and renders; returns the scores as JSON (also
- *  written to summary.json with the baseline and, where `times` is given,
- *  the seconds of each stage, the outputs' parts included). */
+/** Writes a registration's folder: parameters.toml, the pre-alignment
+ *  (rigid_fixed_to_moving.tfm), front.csv, front.json, generations.csv and,
+ *  per chosen solution, a folder with both fields (NIfTI, preprocessed
+ *  frame), both transforms (.h5, original images' space), both meshes (.vtu)
+ *  and, when the fixed structures are known, scores.json and renders; returns
+ *  the scores as JSON (also written to summary.json, last, with the baseline,
+ *  the backend and why, the run's labels and, where `times` is given, the
+ *  seconds of each stage, the outputs' parts included). */
 nlohmann::json
-WriteRegistrationOutputs(const itk::morea::PreprocessResult & preprocessed,
-                         const itk::morea::MeshRegistrationResult & result,
-                         const std::vector<ChosenSolution> & chosen, double borderMargin, const std::string & folder,
+WriteRegistrationOutputs(const itk::morea::MultiObjectiveRegistrationRun & run, const ParameterSet & parameters,
+                         const std::string & folder,
                          const itk::morea::DisplacementFieldType * trueFixedToMoving = nullptr,
                          const CommandTimes * times = nullptr);
 } // namespace morea::cli

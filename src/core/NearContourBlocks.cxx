@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <string>
 
 namespace morea
 {
@@ -19,8 +20,9 @@ FindNearContourBlocks(const ChannelVolume & volume, double radius)
     n[a] = (volume.size[a] + B - 1) / B;
     out.blocks[a] = static_cast<int>(n[a]);
   }
-  if (volume.channels > 9)
-    throw Error("near-contour blocks: at most 8 structures");
+  if (volume.channels > 1 + NearContourBlocks::MaxStructures)
+    throw Error("near-contour blocks: at most " + std::to_string(NearContourBlocks::MaxStructures) +
+                " structures, not " + std::to_string(volume.channels - 1));
   out.mask.assign(n[0] * n[1] * n[2], 0);
   // The texture filter rounds its weights and sums in single precision.
   const double limit = radius * (1.0 + 1e-5) + 1e-6;
@@ -29,10 +31,10 @@ FindNearContourBlocks(const ChannelVolume & volume, double radius)
     for (std::size_t y = 0; y < volume.size[1]; ++y)
       for (std::size_t x = 0; x < volume.size[0]; ++x, ++v)
       {
-        std::uint8_t structures = 0;
+        std::uint16_t structures = 0;
         for (std::size_t g = 1; g < volume.channels; ++g)
           if (volume.data[volume.channels * v + g] < limit)
-            structures |= static_cast<std::uint8_t>(1u << (g - 1));
+            structures |= static_cast<std::uint16_t>(1u << (g - 1));
         if (structures == 0)
           continue;
         // Voxel i lies in the ranges of block i / B and, on a block's first

@@ -52,8 +52,9 @@ MakeSpecs()
     Bool("zip", false, "compress the run's output folder"),
     Bool("problem_guidance_enabled", true, "use the structures' contours as the guidance objective"),
     Text("problem_guidance_selection", "-1", {}, "guidance structures: -1 for all, or comma-separated names"),
-    Int("cuda_compute_level", 90, 50, 200, "CUDA compute capability the kernels target (x10)"),
-    Int("cuda_gpu_id", 0, 0, 64, "CUDA device ordinal"),
+    Int("cuda_compute_level", 80, 50, 200,
+        "lowest CUDA compute capability (x10) a device must have to run the registration (auto: else the CPU)"),
+    Int("cuda_gpu_id", 0, 0, 64, "CUDA device ordinal the registration runs on"),
     Int("seed", 0, 0, kIntMax, "random seed of the run"),
     // MO-RV-GOMEA.
     Int("ea_num_generations", 500, 1, 1e7, "generations to run"),

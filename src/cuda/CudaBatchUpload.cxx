@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace morea
 {
@@ -129,7 +130,8 @@ CudaEvaluationBackend::UploadPacked(const ChannelVolume & volume, cuda::DeviceAr
       throw Error("CUDA backend: an image of " + std::to_string(view.size[0]) + " x " + std::to_string(view.size[1]) +
                   " x " + std::to_string(depth) + " voxels exceeds the texture path's limits on this device (" +
                   std::to_string(maxWidth) + " x " + std::to_string(maxHeight) + " per slice, " +
-                  std::to_string(maxLayers - 1) + " slices); use --backend cuda, or a coarser preprocessing spacing");
+                  std::to_string(maxLayers - 1) +
+                  " slices); use --backend cuda-exact (the exact CUDA kernels), or a coarser preprocessing spacing");
     const int  layers[3] = { view.size[0], view.size[1], depth + 1 };
     const auto slicePairs = [&](const std::vector<std::uint16_t> & texels) {
       std::vector<std::uint16_t> pairs(2 * slice * (depth + 1));
@@ -150,26 +152,28 @@ CudaEvaluationBackend::UploadPacked(const ChannelVolume & volume, cuda::DeviceAr
     textures.intensity = slicePairs(intensity);
     view.intensityTexture = static_cast<unsigned long long>(textures.intensity->Get());
     const std::size_t structures = volume.channels - 1;
+    if (structures > static_cast<std::size_t>(cuda::MaxTextureStructures))
+      throw Error("CUDA backend: the texture path reads at most " + std::to_string(cuda::MaxTextureStructures) +
+                  " guidance structures, not " + std::to_string(structures));
     if (structures > 0)
     {
-      // One float map per structure (the packed path holds at most
-      // MaxTextureStructures) for the set-up kernel, and its 16-bit slice
-      // pairs for the sampling kernel (as a 16-bit normalised 3D texture,
-      // one that took two filtering passes, they measured 11 % slower on an
-      // H100; as slice pairs, 2 % faster).
-      std::vector<float> distance(voxels);
+      // Per structure its 16-bit slice pairs for the sampling kernel (as a
+      // 16-bit normalised 3D texture, one that took two filtering passes,
+      // they measured 11 % slower on an H100; as slice pairs, 2 % faster),
+      // and for the set-up kernel one float map of the smallest distance
+      // over all of them.
+      std::vector<float> distance(voxels), nearest(voxels, std::numeric_limits<float>::infinity());
       double             quantum = 0.0;
       for (std::size_t g = 0; g < structures; ++g)
       {
-        for (std::size_t v = 0; v < voxels; ++v)
-          distance[v] = volume.data[volume.channels * v + 1 + g];
-        textures.distances[g] =
-          std::make_unique<cuda::Texture3D>(distance.data(), sizeof(float), cudaCreateChannelDesc<float>(), view.size);
-        view.distanceTextures[g] = static_cast<unsigned long long>(textures.distances[g]->Get());
-        // The sampling kernel's copy: 16-bit steps of the largest distance.
         float largest = 0.0f;
-        for (float d : distance)
-          largest = std::max(largest, d);
+        for (std::size_t v = 0; v < voxels; ++v)
+        {
+          distance[v] = volume.data[volume.channels * v + 1 + g];
+          nearest[v] = std::min(nearest[v], distance[v]);
+          largest = std::max(largest, distance[v]);
+        }
+        // The sampling kernel's copy: 16-bit steps of the largest distance.
         const float                scale = std::max(largest, 1e-6f);
         std::vector<std::uint16_t> steps(voxels);
         for (std::size_t v = 0; v < voxels; ++v)
@@ -179,16 +183,31 @@ CudaEvaluationBackend::UploadPacked(const ChannelVolume & volume, cuda::DeviceAr
         view.distanceScales[g] = scale;
         quantum = std::max(quantum, static_cast<double>(scale) / 65535.0);
       }
+      textures.nearestDistance =
+        std::make_unique<cuda::Texture3D>(nearest.data(), sizeof(float), cudaCreateChannelDesc<float>(), view.size);
+      view.nearestDistanceTexture = static_cast<unsigned long long>(textures.nearestDistance->Get());
       view.distanceMaps = static_cast<int>(structures);
       // A rounded texel is at most half a step below its distance.
       const NearContourBlocks near = FindNearContourBlocks(volume, m_Constants.guidanceRadius + quantum);
-      // Four bits per block (a structure each), so that the mask stays
-      // small enough for L1.
-      std::vector<std::uint8_t> bits((near.mask.size() + 1) / 2, 0);
+      // As few bits per block as hold the structures (cuda::NearBlockBits),
+      // so that the mask stays small enough for L1.
+      const int                 bits = cuda::NearBlockBits(static_cast<int>(structures));
+      std::vector<std::uint8_t> mask((near.mask.size() * static_cast<std::size_t>(bits) + 7) / 8, 0);
       for (std::size_t b = 0; b < near.mask.size(); ++b)
-        bits[b / 2] |= static_cast<std::uint8_t>((near.mask[b] & 0x0fu) << (4 * (b % 2)));
-      textures.nearBlocks.Reserve(bits.size());
-      Check(cudaMemcpy(textures.nearBlocks.Data(), bits.data(), bits.size(), cudaMemcpyHostToDevice),
+      {
+        const std::uint32_t m = near.mask[b];
+        if (bits == 4)
+          mask[b / 2] |= static_cast<std::uint8_t>((m & 0x0fu) << (4 * (b % 2)));
+        else if (bits == 8)
+          mask[b] = static_cast<std::uint8_t>(m);
+        else
+        {
+          mask[2 * b] = static_cast<std::uint8_t>(m & 0xffu);
+          mask[2 * b + 1] = static_cast<std::uint8_t>(m >> 8);
+        }
+      }
+      textures.nearBlocks.Reserve(mask.size());
+      Check(cudaMemcpy(textures.nearBlocks.Data(), mask.data(), mask.size(), cudaMemcpyHostToDevice),
             "uploading the near-contour blocks");
       view.nearBlocks = textures.nearBlocks.Data();
       for (int a = 0; a < 3; ++a)

@@ -54,11 +54,11 @@ CudaUnavailableReason()
   return count == 0 ? "no CUDA device present" : "";
 }
 
-CudaContextWarmUp::CudaContextWarmUp()
-  : m_Thread([] {
+CudaContextWarmUp::CudaContextWarmUp(int device)
+  : m_Thread([device] {
     // The runtime creates the primary context on its first call that
     // needs one; later calls on any thread find it made.
-    if (cudaSetDevice(0) != cudaSuccess || cudaFree(nullptr) != cudaSuccess)
+    if (cudaSetDevice(device) != cudaSuccess || cudaFree(nullptr) != cudaSuccess)
       cudaGetLastError(); // the backend reports what is wrong when it is made
   })
 {}

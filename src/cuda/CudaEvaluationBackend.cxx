@@ -7,14 +7,14 @@ namespace morea
 namespace cudabackend
 {
 CudaEvaluationBackend::CudaEvaluationBackend(const TetrahedronEvaluator & evaluator, std::size_t threads,
-                                             CudaInterpolation interpolation)
+                                             CudaInterpolation interpolation, int device)
   : m_Evaluator(evaluator)
   , m_Pool(ThreadPool::Shared(threads))
 {
   const std::string unavailable = CudaUnavailableReason();
   if (!unavailable.empty())
     throw Error("CUDA backend: " + unavailable);
-  Check(cudaSetDevice(0), "selecting device 0");
+  Check(cudaSetDevice(device), ("selecting device " + std::to_string(device)).c_str());
   m_Stream = std::make_unique<cuda::Stream>();
   m_CopyStream = std::make_unique<cuda::Stream>();
   for (auto & stream : m_FoldStreams)
@@ -34,7 +34,7 @@ CudaEvaluationBackend::CudaEvaluationBackend(const TetrahedronEvaluator & evalua
   const ObjectiveData & data = evaluator.Data();
   m_Constants.structures = static_cast<int>(data.NumberOfGuidanceStructures());
   m_Constants.guidanceWeights = Upload(data.guidanceWeights, m_GuidanceWeights);
-  for (std::size_t g = 0; g < std::min<std::size_t>(3, data.guidanceWeights.size()); ++g)
+  for (std::size_t g = 0; g < std::min<std::size_t>(cuda::MaxTextureStructures, data.guidanceWeights.size()); ++g)
     m_Constants.textureGuidanceWeights[g] = static_cast<float>(data.guidanceWeights[g]);
   m_Constants.guidanceRadius = data.guidanceRadius;
   m_Constants.samplingRate = data.samplingRate;
@@ -43,14 +43,24 @@ CudaEvaluationBackend::CudaEvaluationBackend(const TetrahedronEvaluator & evalua
   m_Constants.referenceVolumes = Upload(evaluator.Constraint().ReferenceVolumes(), m_ReferenceVolumes);
   m_Constants.tetrahedra = static_cast<std::uint32_t>(evaluator.Constraint().ReferenceVolumes().size());
   m_Constants.volumeFraction = evaluator.Constraint().VolumeFraction();
-  if (data.moving.channels <= 4)
+  // The texture path keeps each structure in textures of its own, up to
+  // MaxTextureStructures; the packed exact kernel reads 4 channels per voxel
+  // at once (intensity and up to 3 distances); the generic exact kernel
+  // any number.
+  const std::size_t structures = data.moving.channels > 0 ? data.moving.channels - 1 : 0; // what the textures hold
+  const bool        texture =
+    interpolation == CudaInterpolation::Texture && structures <= static_cast<std::size_t>(cuda::MaxTextureStructures);
+  if (interpolation == CudaInterpolation::Texture && !texture)
+    m_PathNote = "exact CUDA kernels instead of the texture path: " + std::to_string(structures) +
+                 " guidance structures, the texture path reads at most " +
+                 std::to_string(cuda::MaxTextureStructures);
+  if (texture || data.moving.channels <= 4)
   {
-    // The fast kernels read 4 channels per voxel at once.
+    const CudaInterpolation packed = texture ? CudaInterpolation::Texture : CudaInterpolation::Exact;
     m_Constants.packed = true;
-    m_Constants.interpolation =
-      interpolation == CudaInterpolation::Texture ? cuda::Interpolation::Texture : cuda::Interpolation::Exact;
-    m_Constants.packedMoving = UploadPacked(data.moving, m_PackedMoving, m_MovingTextures, interpolation);
-    m_Constants.packedFixed = UploadPacked(data.fixed, m_PackedFixed, m_FixedTextures, interpolation);
+    m_Constants.interpolation = texture ? cuda::Interpolation::Texture : cuda::Interpolation::Exact;
+    m_Constants.packedMoving = UploadPacked(data.moving, m_PackedMoving, m_MovingTextures, packed);
+    m_Constants.packedFixed = UploadPacked(data.fixed, m_PackedFixed, m_FixedTextures, packed);
   }
   else
   {
@@ -422,8 +432,8 @@ CudaEvaluationBackend::UnpackSolutions(const BatchFlight & f, std::size_t n,
 
 std::unique_ptr<EvaluationBackend>
 CreateCudaEvaluationBackend(const TetrahedronEvaluator & evaluator, std::size_t threads,
-                            CudaInterpolation interpolation)
+                            CudaInterpolation interpolation, int device)
 {
-  return std::make_unique<cudabackend::CudaEvaluationBackend>(evaluator, threads, interpolation);
+  return std::make_unique<cudabackend::CudaEvaluationBackend>(evaluator, threads, interpolation, device);
 }
 } // namespace morea

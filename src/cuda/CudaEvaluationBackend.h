@@ -75,10 +75,10 @@ constexpr double FirstChunkRoomPerItem = 6.0;
 /** The texture path's textures of one image. */
 struct VolumeTextures
 {
-  std::unique_ptr<cuda::Texture3D>                                     intensity;
-  std::array<std::unique_ptr<cuda::Texture3D>, cuda::MaxTextureStructures> distances;
+  std::unique_ptr<cuda::Texture3D>                                         intensity;
+  std::unique_ptr<cuda::Texture3D>                                         nearestDistance;
   std::array<std::unique_ptr<cuda::Texture3D>, cuda::MaxTextureStructures> distancePairs;
-  cuda::DeviceArray<std::uint8_t>  nearBlocks; ///< see cuda::PackedVolumeView::nearBlocks
+  cuda::DeviceArray<std::uint8_t> nearBlocks; ///< see cuda::PackedVolumeView::nearBlocks
 };
 
 static_assert(NearContourBlocks::BlockSize == cuda::NearBlockSize, "the sampling kernel's blocks are the core's");
@@ -262,12 +262,21 @@ private:
 class CudaEvaluationBackend final : public EvaluationBackend
 {
 public:
-  CudaEvaluationBackend(const TetrahedronEvaluator & evaluator, std::size_t threads, CudaInterpolation interpolation);
+  CudaEvaluationBackend(const TetrahedronEvaluator & evaluator, std::size_t threads, CudaInterpolation interpolation,
+                        int device = 0);
 
   std::string
   Name() const override
   {
     return m_Constants.packed && m_Constants.interpolation == cuda::Interpolation::Texture ? "cuda-texture" : "cuda";
+  }
+
+  /** Why the texture path, asked for, does not run (more structures than it
+   *  reads); "" otherwise. */
+  std::string
+  PathNote() const override
+  {
+    return m_PathNote;
   }
 
   void
@@ -664,6 +673,7 @@ private:
    *  first (see ChunkRoomPerItem). */
   double                        m_MostChunksPerItem{ -1.0 };
   cuda::EvaluationConstants     m_Constants;
+  std::string                   m_PathNote; ///< see PathNote
   cuda::DeviceArray<float>      m_Moving, m_Fixed, m_PackedMoving, m_PackedFixed;
   VolumeTextures m_MovingTextures, m_FixedTextures;
   cuda::DeviceArray<double>     m_GuidanceWeights, m_Elasticity, m_ReferenceVolumes;

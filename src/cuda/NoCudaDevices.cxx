@@ -23,7 +23,7 @@ CudaUnavailableReason()
   return "this build has no CUDA backend (nvcc was not found when it was configured)";
 }
 
-CudaContextWarmUp::CudaContextWarmUp() = default;
+CudaContextWarmUp::CudaContextWarmUp(int) {}
 
 CudaContextWarmUp::~CudaContextWarmUp() = default;
 
@@ -40,7 +40,7 @@ MeasureTrilinearFetchRate()
 }
 
 std::unique_ptr<EvaluationBackend>
-CreateCudaEvaluationBackend(const TetrahedronEvaluator &, std::size_t, CudaInterpolation)
+CreateCudaEvaluationBackend(const TetrahedronEvaluator &, std::size_t, CudaInterpolation, int)
 {
   throw Error("CUDA backend: " + CudaUnavailableReason());
 }

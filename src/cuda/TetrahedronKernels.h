@@ -26,39 +26,60 @@ enum class Interpolation
   Texture  ///< the texture units' filtering (8-bit weights across x and y: faster, not bit-comparable)
 };
 
-/** A volume with at most 4 channels. Exact: channels padded to 4, float4
- *  per voxel in global memory. Texture: the intensity as 16-bit normalised
- *  texels (2 bytes: small footprint, many samples per cache line) and the
- *  distance maps as textures of their own, read only near a contour. */
-/** Structures whose distances the texture path reads (the packed kernels
- *  read 4 channels per voxel: intensity and up to 3 distances). */
-constexpr int MaxTextureStructures = 3;
+/** Structures whose distances the texture path reads. Each has textures
+ *  of its own, read only near its contour (nearBlocks), so the number costs
+ *  only the fetches near contours, the textures' memory and the mask's
+ *  bits; with more, the backend takes the exact kernels and says why
+ *  (EvaluationBackend::PathNote). */
+constexpr int MaxTextureStructures = 16;
 
+/** Bits per block of PackedVolumeView::nearBlocks for `structures`
+ *  structures: 4 (two blocks per byte) up to 4 structures, 8 up to 8, else
+ *  16. The fewest that hold them: the mask stays small enough for L1 (9 KB
+ *  at 4 bits for the paper's abdomen pair). */
+constexpr int
+NearBlockBits(int structures)
+{
+  return structures <= 4 ? 4 : (structures <= 8 ? 8 : 16);
+}
+
+/** The images as the fast kernels read them. Exact (at most 4 channels):
+ *  channels padded to 4, float4 per voxel in global memory. Texture (at
+ *  most MaxTextureStructures structures): the intensity as 16-bit
+ *  normalised texels (2 bytes: small footprint, many samples per cache
+ *  line) and each structure's distance map as textures of its own, read
+ *  only near its contour. */
 struct PackedVolumeView
 {
   const void *       data{ nullptr };            ///< Exact: float4 per voxel
   unsigned long long intensityTexture{ 0 };      ///< Texture: cudaTextureObject_t, slice pairs (SlicePairTrilinear)
-  /** Texture: one float texture per structure (cudaTextureObject_t; 0
-   *  past distanceMaps), read by the set-up kernel at each tetrahedron's
-   *  centre. */
-  unsigned long long distanceTextures[MaxTextureStructures]{ 0, 0, 0 };
-  /** Texture: the same distances as slice pairs of 16-bit normalised texels
-   *  (SlicePairTrilinear), times distanceScales[g] in mm (the largest
-   *  distance, so steps of 1/65535 of it): what the
+  /** Texture: the smallest distance over all structures as one float
+   *  texture (cudaTextureObject_t; 0 without structures), read by the
+   *  set-up kernel at each tetrahedron's centre. Its interpolated value is
+   *  never above the smallest of the structures' interpolated distances
+   *  (trilinear weights are convex, the minimum concave), so a tetrahedron
+   *  it finds far from every contour is; one fetch instead of one per
+   *  structure. */
+  unsigned long long nearestDistanceTexture{ 0 };
+  /** Texture: per structure its distances as slice pairs of 16-bit
+   *  normalised texels (SlicePairTrilinear), times distanceScales[g] in mm
+   *  (the largest distance, so steps of 1/65535 of it): what the
    *  sampling kernel reads, in one filtering pass at the layer it already
    *  found for the intensity, where a float 3D texture took two. On an
    *  H100, early generations' kernels served 9.77e10 samples per second
    *  against 9.58e10, with the guidance closer to the CPU's (the weight
-   *  along z in single precision). */
-  unsigned long long distancePairTextures[MaxTextureStructures]{ 0, 0, 0 };
-  float              distanceScales[MaxTextureStructures]{ 0.0f, 0.0f, 0.0f };
+   *  along z in single precision). 0 past distanceMaps. */
+  unsigned long long distancePairTextures[MaxTextureStructures]{};
+  float              distanceScales[MaxTextureStructures]{};
   int                distanceMaps{ 0 }; ///< Texture: structures (0: none)
-  /** Texture: per block of NearBlockSize^3 texels (x fastest) 4 bits (of
-   *  byte b / 2, the low ones for even b), bit g set where a sample whose
+  /** Texture: per block of NearBlockSize^3 texels (x fastest)
+   *  NearBlockBits(distanceMaps) bits, bit g set where a sample whose
    *  trilinear footprint starts in the block may lie within the guidance
    *  radius of structure g's contour: the smallest distance of the texels it
    *  can read is below the radius (an interpolated value is never below its
-   *  texels' minimum). Null without structures. Bits rather than a byte per
+   *  texels' minimum). At 4 bits block b takes the low half of byte b / 2
+   *  for even b, the high half for odd b; at 16 bits a little-endian
+   *  16-bit word. Null without structures. Bits rather than a byte per
    *  block keep the mask small enough for L1 (9 KB for the paper's abdomen
    *  pair); with one bit per block for all structures, late generations'
    *  kernels on an H100 took 0.0898 s per generation against 0.0911 s with
@@ -89,7 +110,10 @@ struct EvaluationConstants
   const double *  referenceVolumes{ nullptr }; ///< signed base volume per tetrahedron
   std::uint32_t   tetrahedra{ 0 };             ///< of the mesh
   double          volumeFraction{ 0.0 };
-  /** Set when the images have at most 4 channels: the fast kernels use these. */
+  /** Set when packedMoving and packedFixed hold the images: the exact path
+   *  with at most 4 channels, the texture path with at most
+   *  MaxTextureStructures structures. Otherwise `moving` and `fixed` do
+   *  (the generic exact kernel, any number of channels). */
   bool             packed{ false };
   Interpolation    interpolation{ Interpolation::Exact };
   PackedVolumeView packedMoving, packedFixed;
@@ -101,7 +125,7 @@ struct EvaluationConstants
    *  8.33e10 with 512. */
   std::uint32_t chunkSamples{ 512 };
   /** The guidance weights again, by value, for the texture kernels. */
-  float textureGuidanceWeights[3]{ 0.0f, 0.0f, 0.0f };
+  float textureGuidanceWeights[MaxTextureStructures]{};
 };
 
 /** A batch of partial candidates as the device sees it: each candidate is a

@@ -11,6 +11,10 @@
 // path; only the interpolation weights across x and y (8 fraction bits in
 // the texture units), the 16-bit intensity texels and the single-precision
 // arithmetic differ. Intensities are read as slice pairs (SlicePairTrilinear).
+// Each guidance structure (up to MaxTextureStructures) has slice pairs of its
+// own, read only where a per-block mask says its contour may be within the
+// radius; the sampling kernels come in instances for 3, 4, 8 and 16
+// structures (WithStructureSlots).
 #include "TetrahedronKernels.h"
 
 #include "DeviceMemory.h"
@@ -21,8 +25,10 @@
 #include <cub/device/device_radix_sort.cuh>
 #include <cub/device/device_scan.cuh>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
+#include <type_traits>
 
 namespace morea::cuda
 {
@@ -206,10 +212,10 @@ PrepareDirection(const EvaluationConstants & k, const double from[12], const dou
   float t[3];
   for (int a = 0; a < 3; ++a)
     t[a] = static_cast<float>((centre[a] - fromImage.origin[a]) * fromImage.inverseSpacing[a]) + 0.5f;
-  double nearest = INFINITY;
-  for (int g = 0; g < fromImage.distanceMaps; ++g)
-    nearest = fmin(nearest, static_cast<double>(tex3D<float>(
-                              static_cast<cudaTextureObject_t>(fromImage.distanceTextures[g]), t[0], t[1], t[2])));
+  // The smallest distance over all structures, interpolated: never above
+  // the smallest interpolated distance (PackedVolumeView::nearestDistanceTexture).
+  const double nearest = static_cast<double>(
+    tex3D<float>(static_cast<cudaTextureObject_t>(fromImage.nearestDistanceTexture), t[0], t[1], t[2]));
   const double margin = 0.02 * spacing + 1e-4 * fabs(nearest);
   task.nearContour = nearest - 2.0 * reach - margin < k.guidanceRadius ? 1u : 0u;
 }
@@ -315,9 +321,8 @@ struct SamplingConstants
   const std::uint8_t *movingNearBlocks, *fixedNearBlocks; ///< see PackedVolumeView::nearBlocks
   int                 movingBlocks[3], fixedBlocks[3];
   float               movingDepth, fixedDepth; ///< slices of each image (its top layer)
-  float               guidanceWeights[3];
+  float               guidanceWeights[MaxTextureStructures];
   float               radius, inverseRadius;
-  int                 structures;
   std::uint32_t       chunkIterations; ///< 32 samples each
 };
 
@@ -372,12 +377,18 @@ ScatterChunkTasks(const std::uint32_t * __restrict__ sortedItems, const std::uin
     chunkTask[c] = task;
 }
 
+/** The mask's bits per block for a kernel instance reading `Slots`
+ *  structures (the host's NearBlockBits for as many). */
+template <int Slots>
+constexpr int SlotMaskBits = NearBlockBits(Slots);
+
 /** The structures whose distance at texel position `p` (along z the
  *  slice-pair coordinate, TexelCorners) may be below the guidance radius
- *  (PackedVolumeView::nearBlocks: bit g for structure g). The block of the
- *  footprint's first texel floor(p - 1/2), along z floor(s - 1), clamped as
- *  the texture clamps: the rule of morea::NearContourBlocks::BlockOf, in
- *  texel coordinates. */
+ *  (PackedVolumeView::nearBlocks, MaskBits bits per block: bit g for
+ *  structure g). The block of the footprint's first texel floor(p - 1/2),
+ *  along z floor(s - 1), clamped as the texture clamps: the rule of
+ *  morea::NearContourBlocks::BlockOf, in texel coordinates. */
+template <int MaskBits>
 __device__ unsigned
 NearStructures(const std::uint8_t * __restrict__ nearBlocks, const int blocks[3], const float p[3])
 {
@@ -393,7 +404,12 @@ NearStructures(const std::uint8_t * __restrict__ nearBlocks, const int blocks[3]
     b[a] = min(__float2uint_rd(fmaf(p[a], 1.0f / NearBlockSize, (a == 2 ? -1.0f : -0.5f) / NearBlockSize)),
                static_cast<unsigned>(blocks[a] - 1));
   const unsigned block = (b[2] * static_cast<unsigned>(blocks[1]) + b[1]) * static_cast<unsigned>(blocks[0]) + b[0];
-  return (__ldg(nearBlocks + (block >> 1)) >> (4 * (block & 1u))) & 0x0fu;
+  if constexpr (MaskBits == 4)
+    return (__ldg(nearBlocks + (block >> 1)) >> (4 * (block & 1u))) & 0x0fu;
+  else if constexpr (MaskBits == 8)
+    return __ldg(nearBlocks + block);
+  else
+    return __ldg(reinterpret_cast<const std::uint16_t *>(nearBlocks) + block);
 }
 
 /** __log2f and __fdividef(1, x) without their guards for subnormal
@@ -418,7 +434,7 @@ ReciprocalApproximate(float x)
 }
 
 /** Adds one sample's terms; `state`: its Sobol state (shift included). */
-template <int Direction>
+template <int Direction, int Slots>
 __device__ __forceinline__ void
 SamplePoint(const SamplingConstants & k, const float4 * corners, bool near, const std::uint32_t state[4],
             float & intensity, float & guidance)
@@ -474,11 +490,12 @@ SamplePoint(const SamplingConstants & k, const float4 * corners, bool near, cons
   {
     // One test for the common case of no structure near the sample, not
     // one per structure.
-    const unsigned structures = NearStructures(fromNearBlocks, fromBlocks, p);
+    const unsigned structures = NearStructures<SlotMaskBits<Slots>>(fromNearBlocks, fromBlocks, p);
     if (structures != 0)
     {
+      // Unrolled: each structure's textures stay uniform kernel parameters.
 #pragma unroll
-      for (int g = 0; g < MaxTextureStructures; ++g)
+      for (int g = 0; g < Slots; ++g)
         if ((structures >> g) & 1u)
         {
           const float d =
@@ -499,7 +516,7 @@ SamplePoint(const SamplingConstants & k, const float4 * corners, bool near, cons
 
 /** Samples rows j, j + 1, ... of a chunk (32 consecutive samples each) up
  *  to the chunk's end; `state`: the Sobol state of row j for this lane. */
-template <int Direction>
+template <int Direction, int Slots>
 __device__ void
 SampleRows(const SamplingConstants & k, const float4 * corners, std::uint32_t j, std::uint32_t n, bool near, int lane,
            std::uint32_t state[4], float & intensity, float & guidance)
@@ -508,7 +525,7 @@ SampleRows(const SamplingConstants & k, const float4 * corners, std::uint32_t j,
   for (std::uint32_t row = 32 * j;;)
   {
     if (row + lane < end)
-      SamplePoint<Direction>(k, corners, near, state, intensity, guidance);
+      SamplePoint<Direction, Slots>(k, corners, near, state, intensity, guidance);
     row += 32;
     if (row >= end)
       break;
@@ -525,14 +542,14 @@ SampleRows(const SamplingConstants & k, const float4 * corners, std::uint32_t j,
 /** Samples a whole chunk of 512 by cosets (morea/SampleCosets.h) of a block
  *  of 2^(MinCosetBits + level); `state`: the Sobol state of the chunk's
  *  first coset for this lane. */
-template <int Direction>
+template <int Direction, int Slots>
 __device__ void
 SampleCosetRows(const SamplingConstants & k, const float4 * corners, bool near, int level, std::uint32_t state[4],
                 float & intensity, float & guidance)
 {
   for (std::uint32_t row = 0;;)
   {
-    SamplePoint<Direction>(k, corners, near, state, intensity, guidance);
+    SamplePoint<Direction, Slots>(k, corners, near, state, intensity, guidance);
     if (++row == CosetRows)
       break;
     const uint4 step = c_CosetRowSteps[level][__ffs(static_cast<int>(row)) - 1];
@@ -604,6 +621,7 @@ LoadChunk(const SampleTask * __restrict__ tasks, const std::uint32_t * __restric
  *    diagnostic build whose 32 lanes differed only in dimension 1 (wrong
  *    values) reached 1.13e11: close points pay. Offsets chosen from the
  *    whole block, not single bits, find them (morea/SampleCosets.h). */
+template <int Slots>
 __device__ void
 SampleChunk(const SamplingConstants & k, const ChunkHeader & h, std::size_t chunk, int lane, const float4 * corners,
             double2 * chunkSums, double * directionOut)
@@ -651,14 +669,14 @@ SampleChunk(const SamplingConstants & k, const ChunkHeader & h, std::size_t chun
   if (cosets) // both conditions are the same for the whole warp
   {
     if (direction == 0)
-      SampleCosetRows<0>(k, corners, h.near, level, state, intensity, guidance);
+      SampleCosetRows<0, Slots>(k, corners, h.near, level, state, intensity, guidance);
     else
-      SampleCosetRows<1>(k, corners, h.near, level, state, intensity, guidance);
+      SampleCosetRows<1, Slots>(k, corners, h.near, level, state, intensity, guidance);
   }
   else if (direction == 0)
-    SampleRows<0>(k, corners, j, h.n, h.near, lane, state, intensity, guidance);
+    SampleRows<0, Slots>(k, corners, j, h.n, h.near, lane, state, intensity, guidance);
   else
-    SampleRows<1>(k, corners, j, h.n, h.near, lane, state, intensity, guidance);
+    SampleRows<1, Slots>(k, corners, j, h.n, h.near, lane, state, intensity, guidance);
   const double intensitySum = WarpSum(static_cast<double>(intensity));
   const double guidanceSum = WarpSum(static_cast<double>(guidance));
   if (lane != 0)
@@ -681,6 +699,7 @@ SampleChunk(const SamplingConstants & k, const ChunkHeader & h, std::size_t chun
  *  chunk's header loads while the first is sampled: on an H100, 9.09e10
  *  samples per second against 9.02e10 with one chunk per warp, the same
  *  sums. */
+template <int Slots>
 __global__ void __launch_bounds__(SampleWarpsPerBlock * 32, SampleBlocksPerMultiprocessor)
 SampleTextureChunks(SamplingConstants k, const SampleTask * __restrict__ tasks,
                     const std::uint32_t * __restrict__ taskFirstChunk, const std::uint32_t * __restrict__ chunkTask,
@@ -700,9 +719,9 @@ SampleTextureChunks(SamplingConstants k, const SampleTask * __restrict__ tasks,
   if (second)
     b = LoadChunk(tasks, taskFirstChunk, chunkTask, first + 1, lane, 8, corners[warp][1]);
   __syncwarp();
-  SampleChunk(k, a, first, lane, corners[warp][0], chunkSums, directionOut);
+  SampleChunk<Slots>(k, a, first, lane, corners[warp][0], chunkSums, directionOut);
   if (second)
-    SampleChunk(k, b, first + 1, lane, corners[warp][1], chunkSums, directionOut);
+    SampleChunk<Slots>(k, b, first + 1, lane, corners[warp][1], chunkSums, directionOut);
 }
 
 /** One warp per listed chunk (item, direction, the chunk's place among its
@@ -710,6 +729,7 @@ SampleTextureChunks(SamplingConstants k, const SampleTask * __restrict__ tasks,
  *  up in the warp as step 1 sets it up, and the chunk sampled as in
  *  SampleTextureChunks, so its sums are those the schedule gives it. For a
  *  few candidates' items at a time, without step 1's sort and scan. */
+template <int Slots>
 __global__ void __launch_bounds__(SampleWarpsPerBlock * 32)
 SampleListedChunks(SamplingConstants s, EvaluationConstants k, const double * __restrict__ corners,
                    const uint4 * __restrict__ list, std::size_t entries, double2 * chunkSums)
@@ -746,7 +766,7 @@ SampleListedChunks(SamplingConstants s, EvaluationConstants k, const double * __
   h.near = task.nearContour != 0;
   h.shift = make_uint4(task.shift[0], task.shift[1], task.shift[2], task.shift[3]);
   __syncwarp();
-  SampleChunk(s, h, entry, lane, taskCorners[warp], chunkSums, nullptr);
+  SampleChunk<Slots>(s, h, entry, lane, taskCorners[warp], chunkSums, nullptr);
 }
 
 /** Each direction's chunk sums in chunk order: the result does not depend on
@@ -774,6 +794,29 @@ SumChunks(const SampleTask * __restrict__ tasks, const std::uint32_t * __restric
   out[1] = guidance;
   out[2] = static_cast<double>(tasks[task].samples);
 }
+/** Calls launch(std::integral_constant<int, Slots>) with the sampling
+ *  kernels' instance for the images' structures: it reads at most Slots
+ *  structures per sample, 3, 4, 8 or 16 (MaxTextureStructures), the fewest
+ *  that hold them. A slot costs an unrolled test of its bit per sample near
+ *  a contour, and registers (48 at most): up to 3 structures run the kernel
+ *  of before, instruction for instruction (an instance of 2 slots spilled 8
+ *  bytes; that of 16 spills 4, outside the sampling loops). */
+template <typename Launch>
+void
+WithStructureSlots(const EvaluationConstants & constants, Launch && launch)
+{
+  static_assert(MaxTextureStructures == 16, "the largest instance reads MaxTextureStructures");
+  const int structures = std::max(constants.packedMoving.distanceMaps, constants.packedFixed.distanceMaps);
+  if (structures <= 3)
+    launch(std::integral_constant<int, 3>{});
+  else if (structures <= 4)
+    launch(std::integral_constant<int, 4>{});
+  else if (structures <= 8)
+    launch(std::integral_constant<int, 8>{});
+  else
+    launch(std::integral_constant<int, 16>{});
+}
+
 SamplingConstants
 SamplingConstantsOf(const EvaluationConstants & constants)
 {
@@ -796,11 +839,10 @@ SamplingConstantsOf(const EvaluationConstants & constants)
   }
   k.movingDepth = static_cast<float>(constants.packedMoving.size[2]);
   k.fixedDepth = static_cast<float>(constants.packedFixed.size[2]);
-  for (int g = 0; g < 3; ++g)
+  for (int g = 0; g < MaxTextureStructures; ++g)
     k.guidanceWeights[g] = constants.textureGuidanceWeights[g];
   k.radius = static_cast<float>(constants.guidanceRadius);
   k.inverseRadius = static_cast<float>(1.0 / constants.guidanceRadius);
-  k.structures = constants.structures;
   k.chunkIterations = constants.chunkSamples / 32;
   return k;
 }
@@ -922,8 +964,10 @@ LaunchSampleTexture(const EvaluationConstants & constants, std::size_t items, vo
   {
     const std::size_t warps = (chunkCapacity + 1) / 2;
     const unsigned    sampleBlocks = static_cast<unsigned>((warps + SampleWarpsPerBlock - 1) / SampleWarpsPerBlock);
-    SampleTextureChunks<<<sampleBlocks, SampleWarpsPerBlock * 32, 0, s>>>(
-      k, w.tasks, w.taskFirstChunk, chunkTask, w.scheduleEnds + tasks - 1, chunkCapacity, chunkSums, directionOut);
+    WithStructureSlots(constants, [&](auto slots) {
+      SampleTextureChunks<decltype(slots)::value><<<sampleBlocks, SampleWarpsPerBlock * 32, 0, s>>>(
+        k, w.tasks, w.taskFirstChunk, chunkTask, w.scheduleEnds + tasks - 1, chunkCapacity, chunkSums, directionOut);
+    });
     Check(cudaGetLastError(), "launching the texture sampling kernel");
   }
   SumChunks<<<taskBlocks, 256, 0, s>>>(w.tasks, w.chunkCounts, w.taskFirstChunk, chunkSums, tasks, chunkCapacity,
@@ -937,9 +981,11 @@ LaunchSampleListedChunks(const EvaluationConstants & constants, const double * c
   if (entries == 0)
     return;
   const unsigned blocks = static_cast<unsigned>((entries + SampleWarpsPerBlock - 1) / SampleWarpsPerBlock);
-  SampleListedChunks<<<blocks, SampleWarpsPerBlock * 32, 0, static_cast<cudaStream_t>(stream)>>>(
-    SamplingConstantsOf(constants), constants, corners, reinterpret_cast<const uint4 *>(list), entries,
-    reinterpret_cast<double2 *>(chunkSums));
+  WithStructureSlots(constants, [&](auto slots) {
+    SampleListedChunks<decltype(slots)::value><<<blocks, SampleWarpsPerBlock * 32, 0, static_cast<cudaStream_t>(stream)>>>(
+      SamplingConstantsOf(constants), constants, corners, reinterpret_cast<const uint4 *>(list), entries,
+      reinterpret_cast<double2 *>(chunkSums));
+  });
   Check(cudaGetLastError(), "launching the listed chunks' sampling");
 }
 } // namespace morea::cuda

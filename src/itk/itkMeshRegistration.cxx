@@ -49,8 +49,14 @@ RegisterMeshes(const RegistrationProblem & problem, const ::morea::ParameterSet 
   const ::morea::FoldConstraint constraint(model.topology, model.base.points,
                                                 parameters.GetReal("morea_fold_volume_fraction"));
   const ::morea::TetrahedronEvaluator evaluator(model.topology, constraint, model.elasticity, data);
-  auto backend = ::morea::CreateEvaluationBackend(options.backend, evaluator, options.threads);
+  ::morea::BackendRequest request;
+  request.choice = options.backend;
+  request.device = options.device;
+  request.minimumComputeLevel = options.minimumComputeLevel;
+  request.threads = options.threads;
+  auto backend = ::morea::CreateEvaluationBackend(request, evaluator, &result.backendNote);
   result.backend = backend->Name();
+  result.pathNote = backend->PathNote();
   result.threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
   result.secondsBackend = lap();
   result.secondsModel = result.secondsMesh + result.secondsObjectiveData + result.secondsBackend;

@@ -341,32 +341,41 @@ WriteMeshVtu(const std::string & path, const ::morea::MeshTopology & topology,
   }
 }
 
-void
-WriteSolutionTransforms(const MeshFields & fields, const RigidTransformType * rigid,
-                        const std::string & fixedToMovingPath, const std::string & movingToFixedPath)
+OriginalFrameTransforms
+MakeOriginalFrameTransforms(const MeshFields & fields, const RigidTransformType * rigid)
 {
-  using CompositeType = CompositeTransform<double, Dimension>;
   // CompositeTransform applies the transform added last first.
-  auto forward = CompositeType::New();
-  auto backward = CompositeType::New();
-  // Fresh transforms without inverse fields: the files hold one field each.
+  OriginalFrameTransforms out{ CompositeTransformType::New(), CompositeTransformType::New() };
+  // Fresh transforms without inverse fields: files hold one field each.
   auto u = DisplacementFieldTransformType::New();
   u->SetDisplacementField(fields.fixedToMoving);
   auto v = DisplacementFieldTransformType::New();
   v->SetDisplacementField(fields.movingToFixed);
   if (rigid)
-    forward->AddTransform(const_cast<RigidTransformType *>(rigid));
-  forward->AddTransform(u);
-  backward->AddTransform(v);
+  {
+    auto copy = RigidTransformType::New();
+    copy->SetFixedParameters(rigid->GetFixedParameters());
+    copy->SetParameters(rigid->GetParameters());
+    out.fixedToMoving->AddTransform(copy);
+  }
+  out.fixedToMoving->AddTransform(u);
+  out.movingToFixed->AddTransform(v);
   if (rigid)
   {
     auto inverse = RigidTransformType::New();
     if (!rigid->GetInverse(inverse))
       itkGenericExceptionMacro("the rigid pre-alignment is not invertible");
-    backward->AddTransform(inverse);
+    out.movingToFixed->AddTransform(inverse);
   }
-  for (const auto & [transform, path] : { std::make_pair(forward, fixedToMovingPath),
-                                          std::make_pair(backward, movingToFixedPath) })
+  return out;
+}
+
+void
+WriteSolutionTransforms(const OriginalFrameTransforms & transforms, const std::string & fixedToMovingPath,
+                        const std::string & movingToFixedPath)
+{
+  for (const auto & [transform, path] : { std::make_pair(transforms.fixedToMoving, fixedToMovingPath),
+                                          std::make_pair(transforms.movingToFixed, movingToFixedPath) })
   {
     const std::string tmp = TemporaryPathFor(path);
     auto              writer = TransformFileWriterTemplate<double>::New();

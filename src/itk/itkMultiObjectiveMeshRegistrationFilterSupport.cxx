@@ -5,6 +5,8 @@
 #include "morea/ParetoFront.h"
 
 #include <algorithm>
+#include <chrono>
+#include <future>
 #include <ostream>
 #include <sstream>
 
@@ -143,50 +145,86 @@ SelectSolutions(const ApproximationSet & set, const std::string & selection)
   return chosen;
 }
 
+void
+CheckSingleRunParameters(const ::morea::ParameterSet & parameters)
+{
+  if (const auto runs = parameters.GetInteger("num_runs"); runs > 1)
+    throw ::morea::Error("num_runs = " + std::to_string(runs) +
+                         ": one registration runs at a time here; run it once per seed (morea register runs "
+                         "num_runs registrations with consecutive seeds), or set num_runs = 1");
+  if (parameters.GetBool("zip"))
+    throw ::morea::Error("zip = true: this registration writes no output folder to compress (morea register "
+                         "does); set zip = false");
+}
+
 MultiObjectiveRegistrationRun
 RunMultiObjectiveRegistration(const RegistrationProblem & problem, const ::morea::ParameterSet & parameters,
                               const MeshRegistrationOptions & options, const std::string & selection,
                               const std::function<void(double)> & progress)
 {
+  using Clock = std::chrono::steady_clock;
+  const auto secondsSince = [](Clock::time_point t) {
+    return std::chrono::duration<double>(Clock::now() - t).count();
+  };
   const auto report = [&](double fraction) {
     if (progress)
       progress(fraction);
   };
   // Cheap checks first, so that a typo does not surface after the whole run.
   CheckSolutionSelection(selection);
+  CheckSingleRunParameters(parameters);
+  MeshRegistrationOptions registration = options;
+  registration.device = static_cast<int>(parameters.GetInteger("cuda_gpu_id"));
+  registration.minimumComputeLevel = static_cast<int>(parameters.GetInteger("cuda_compute_level"));
+  {
+    ::morea::BackendRequest request;
+    request.choice = registration.backend;
+    request.device = registration.device;
+    request.minimumComputeLevel = registration.minimumComputeLevel;
+    ::morea::CheckBackendRequest(request); // a device asked for by name but unusable: before the work
+  }
   problem.Validate();
 
   MultiObjectiveRegistrationRun run;
-  PreprocessResult preprocessed = Preprocess(problem, PreprocessOptions::FromParameters(parameters));
-  run.preprocessedFixedImage = preprocessed.problem.fixedImage;
-  run.preprocessedMovingImage = preprocessed.problem.movingImage;
-  run.rigidTransform = preprocessed.rigidTransform;
-  run.preprocessReport = preprocessed.report;
+  auto                          stage = Clock::now();
+  run.preprocessed = Preprocess(problem, PreprocessOptions::FromParameters(parameters));
+  run.secondsPreprocessing = secondsSince(stage);
   report(PreprocessingProgressShare);
 
-  MeshRegistrationOptions registration = options;
   registration.onGeneration = [&](const ::morea::GenerationRecord & record, std::size_t generations) {
     const double done = generations > 0 ? static_cast<double>(record.generation) / static_cast<double>(generations) : 1.0;
     report(PreprocessingProgressShare + (OptimisationProgressEnd - PreprocessingProgressShare) * std::min(1.0, done));
     if (options.onGeneration)
       options.onGeneration(record, generations);
   };
-  const MeshRegistrationResult result = RegisterMeshes(preprocessed.problem, parameters, registration);
-  run.approximationSet = ToApproximationSet(result.front);
-  run.history = result.history;
-  run.backend = result.backend;
-  run.resumedAtGeneration = result.resumedAtGeneration;
+  stage = Clock::now();
+  run.registration = RegisterMeshes(run.preprocessed.problem, parameters, registration);
+  run.secondsRegistration = secondsSince(stage);
+  run.approximationSet = ToApproximationSet(run.registration.front);
   report(OptimisationProgressEnd);
 
-  const auto chosen = SelectSolutions(run.approximationSet, selection);
+  // Two solutions' fields at a time: a rasterisation keeps about two cores busy.
+  stage = Clock::now();
+  const auto  chosen = SelectSolutions(run.approximationSet, selection);
+  const auto & pre = run.preprocessed;
+  const auto  rasterize = [&](std::size_t i) {
+    return RasterizeSolution(run.registration.model.topology, run.registration.front[chosen[i].index].mesh,
+                             pre.problem.fixedImage, pre.problem.movingImage);
+  };
+  std::future<MeshFields> next;
+  if (chosen.size() > 1)
+    next = std::async(std::launch::async, rasterize, 1);
   for (std::size_t i = 0; i < chosen.size(); ++i)
   {
-    const MeshFields fields = RasterizeSolution(result.model.topology, result.front[chosen[i].index].mesh,
-                                                preprocessed.problem.fixedImage, preprocessed.problem.movingImage);
-    run.selected.push_back({ chosen[i], fields.fixedToMovingTransform, fields.movingToFixedTransform });
+    MeshFields fields = i == 0 ? rasterize(0) : next.get();
+    if (i > 0 && i + 1 < chosen.size())
+      next = std::async(std::launch::async, rasterize, i + 1);
+    const OriginalFrameTransforms original = MakeOriginalFrameTransforms(fields, pre.rigidTransform);
+    run.selected.push_back({ chosen[i], std::move(fields), original });
     report(OptimisationProgressEnd +
            (1.0 - OptimisationProgressEnd) * static_cast<double>(i + 1) / static_cast<double>(chosen.size()));
   }
+  run.secondsSelection = secondsSince(stage);
   return run;
 }
 

@@ -108,10 +108,13 @@ Clamped(const ImageType * image, float lo, float hi)
   return copy;
 }
 
-/** Refines `transform` in place on the image intensities near the fixed structure. */
-double
+/** Refines `transform` in place on the image intensities near the fixed
+ *  structure; returns false (and `skipped` says why) when the structure's
+ *  interior holds too few voxels to sample. */
+bool
 RefineOnIntensities(const ImageType * fixedImage, const ImageType * movingImage, const ImageType * fixedDistance,
-                    RigidTransformType * transform, const RigidAlignmentOptions & options)
+                    RigidTransformType * transform, const RigidAlignmentOptions & options, double & metricValue,
+                    std::string & skipped)
 {
   // The region: the structure's interior, `intensityInset` mm away from its outline. The
   // outline itself moves with breathing or filling; the inner detail (vessels, bone
@@ -123,8 +126,21 @@ RefineOnIntensities(const ImageType * fixedImage, const ImageType * movingImage,
   region->Allocate();
   ImageRegionConstIterator<ImageType> d(fixedDistance, fixedDistance->GetLargestPossibleRegion());
   ImageRegionIterator<MaskType>       r(region, region->GetLargestPossibleRegion());
+  std::size_t                         inside = 0;
   for (; !d.IsAtEnd(); ++d, ++r)
+  {
     r.Set(d.Get() <= -options.intensityInset ? 1 : 0);
+    inside += r.Get();
+  }
+  // The coarse level sees an eighth of the voxels, of which the metric
+  // samples a fraction: too few samples make the stage fail or wander.
+  constexpr double MinimumCoarseSamples = 50.0;
+  if (static_cast<double>(inside) / 8.0 * options.samplingFraction < MinimumCoarseSamples)
+  {
+    skipped = "the structure's interior (" + std::to_string(options.intensityInset) + " mm from its outline) holds " +
+              std::to_string(inside) + " voxels, too few to sample; the mask stage's alignment is kept";
+    return false;
+  }
   auto spatialMask = ImageMaskSpatialObject<Dimension>::New();
   spatialMask->SetImage(region);
   spatialMask->Update();
@@ -176,7 +192,8 @@ RefineOnIntensities(const ImageType * fixedImage, const ImageType * movingImage,
   {
     Fail(std::string("rigid pre-alignment (intensity stage) failed: ") + e.GetDescription());
   }
-  return optimizer->GetCurrentMetricValue();
+  metricValue = optimizer->GetCurrentMetricValue();
+  return true;
 }
 } // namespace
 
@@ -253,14 +270,17 @@ AlignRigidly(const MaskType * fixedMask, const MaskType * movingMask, const Rigi
 
   const double maskMetric = optimizer->GetCurrentMetricValue();
   double       intensityMetric = 0.0;
+  bool         refined = false;
+  std::string  skipped;
   if (fixedImage != nullptr && movingImage != nullptr)
-    intensityMetric = RefineOnIntensities(fixedImage, movingImage, fixedMap, transform, options);
+    refined = RefineOnIntensities(fixedImage, movingImage, fixedMap, transform, options, intensityMetric, skipped);
 
   if (result != nullptr)
   {
     result->initialMetric = initialMetric;
     result->finalMetric = maskMetric;
-    result->intensityRefined = fixedImage != nullptr && movingImage != nullptr;
+    result->intensityRefined = refined;
+    result->intensitySkipped = skipped;
     result->intensityMetric = intensityMetric;
     result->iterations = static_cast<unsigned>(optimizer->GetCurrentIteration());
     for (unsigned d = 0; d < Dimension; ++d)

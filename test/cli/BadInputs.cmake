@@ -400,7 +400,7 @@ expect_failure("benchmark: start from a damaged checkpoint" OUTPUTS "${WORK}/ben
        --from-checkpoint "${WORK}/benchmark-bad-checkpoint.bin" -o "${WORK}/benchmark-out.json")
 # Without a GPU (as on CI), a CUDA backend asked for by name fails before any output is written.
 if(NOT EXISTS "/dev/nvidia0")
-  expect_failure("register: CUDA without a device" OUTPUTS ${o} FRAGMENTS "CUDA backend" "--backend auto"
+  expect_failure("register: CUDA without a device" OUTPUTS ${o} FRAGMENTS "backend 'cuda'" "backend auto"
     ARGS register --fixed "${fixed}" --moving "${moving}" ${blob} --set ea_population_size=8 --set ea_num_clusters=2
          --set ea_num_generations=1 --set morea_mesh_num_points=40 --set preprocess_rigid_structure=none
          --backend cuda-texture -o "${o}")

@@ -258,6 +258,29 @@ expect_files("register"
   "${reg}/best_guidance/fixed_to_moving.h5" "${reg}/best_guidance/moving_to_fixed.h5"
   "${reg}/best_guidance/mesh_moving.vtu" "${reg}/best_guidance/mesh_fixed.vtu" "${reg}/best_guidance/scores.json"
   "${reg}/knee/fixed_to_moving.h5")
+# --- register num_runs = 2, zip = true: two seeds in two folders, one archive ---------------------------
+set(runs "${WORK}/runs")
+file(REMOVE_RECURSE "${runs}" "${runs}.zip")
+morea_ok("register num_runs zip" register --problem "${phantom}" ${tiny} --set ea_num_generations=2 --set num_runs=2
+  --set zip=true --select best-guidance -o "${runs}")
+expect_files("register num_runs zip" "${runs}/parameters.toml" "${runs}/run_1/summary.json"
+  "${runs}/run_2/summary.json" "${runs}/run_2/best_guidance/fixed_to_moving.h5" "${runs}.zip")
+file(READ "${runs}/run_2/summary.json" run2)
+string(JSON run2_seed GET "${run2}" seed)
+if(NOT run2_seed EQUAL 3)
+  message(FATAL_ERROR "register num_runs: the second run's seed is ${run2_seed}, not the first's (2) plus 1")
+endif()
+execute_process(COMMAND ${CMAKE_COMMAND} -E tar tf "${runs}.zip" OUTPUT_VARIABLE listed RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0 OR NOT listed MATCHES "runs/run_2/best_guidance/fixed_to_moving.h5")
+  message(FATAL_ERROR "register zip: the archive does not list the second run's transform (${rc}):\n${listed}")
+endif()
+file(MAKE_DIRECTORY "${WORK}/unzipped")
+execute_process(COMMAND ${CMAKE_COMMAND} -E tar xf "${runs}.zip" WORKING_DIRECTORY "${WORK}/unzipped" RESULT_VARIABLE rc)
+file(READ "${WORK}/unzipped/runs/run_2/summary.json" unzipped)
+if(NOT rc EQUAL 0 OR NOT unzipped STREQUAL run2)
+  message(FATAL_ERROR "register zip: the unpacked summary differs from the written one (${rc})")
+endif()
+
 file(STRINGS "${reg}/generations.csv" gen_lines)
 list(LENGTH gen_lines gen_count)
 if(NOT gen_count EQUAL 8) # header, generation 0 (initial population), 1..6

@@ -1,0 +1,92 @@
+#include "FilterRun.h"
+
+#include "itkCommand.h"
+#include "morea/Error.h"
+
+#include <algorithm>
+#include <thread>
+
+namespace morea::cli
+{
+namespace
+{
+using PointSetType = RegistrationFilterType::PointSetType;
+
+PointSetType::Pointer
+ToPointSet(const itk::morea::PointListType & points)
+{
+  if (points.empty())
+    return nullptr;
+  auto set = PointSetType::New();
+  auto container = PointSetType::PointsContainer::New();
+  container->Reserve(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i)
+  {
+    PointSetType::PointType p;
+    for (unsigned d = 0; d < 3; ++d)
+      p[d] = static_cast<float>(points[i][d]);
+    container->SetElement(i, p);
+  }
+  set->SetPoints(container);
+  return set;
+}
+} // namespace
+
+RegistrationFilterType::Pointer
+MakeRegistrationFilter(const itk::morea::RegistrationProblem & problem, const ParameterSet & parameters,
+                       const FilterSettings & settings)
+{
+  auto filter = RegistrationFilterType::New();
+  filter->SetFixedImage(problem.fixedImage);
+  filter->SetMovingImage(problem.movingImage);
+  for (const auto & s : problem.structures)
+  {
+    if (s.fixedMask || s.movingMask)
+      filter->AddStructure(s.name, s.fixedMask, s.movingMask);
+    const auto fixedPoints = ToPointSet(s.fixedPoints);
+    const auto movingPoints = ToPointSet(s.movingPoints);
+    if (fixedPoints || movingPoints)
+      filter->AddStructurePoints(s.name, fixedPoints, movingPoints);
+  }
+  filter->SetFixedBodyMask(problem.fixedBodyMask);
+  filter->SetMovingBodyMask(problem.movingBodyMask);
+  filter->SetFixedLandmarks(ToPointSet(problem.fixedLandmarks));
+  filter->SetMovingLandmarks(ToPointSet(problem.movingLandmarks));
+  filter->SetParameters(parameters);
+  filter->SetBackend(settings.backend);
+  filter->SetNumberOfWorkUnits(static_cast<itk::ThreadIdType>(
+    settings.threads ? settings.threads : std::max(1u, std::thread::hardware_concurrency())));
+  filter->SetRefusalBounds(settings.refusalBounds);
+  filter->SetSelection(settings.selection);
+  filter->SetCheckpointFile(settings.checkpointFile);
+  filter->SetCheckpointInterval(settings.checkpointInterval);
+  filter->SetResume(settings.resume);
+  if (settings.onGeneration)
+  {
+    RegistrationFilterType * f = filter.GetPointer(); // the filter owns the observer: no cycle
+    filter->AddObserver(itk::IterationEvent(), [f, onGeneration = settings.onGeneration](const itk::EventObject &) {
+      onGeneration(f->GetLastGenerationRecord(), f->GetNumberOfGenerations());
+    });
+  }
+  return filter;
+}
+
+void
+UpdateRegistrationFilter(RegistrationFilterType & filter)
+{
+  try
+  {
+    filter.Update();
+  }
+  catch (const itk::ExceptionObject & e)
+  {
+    // The message without ITK's "ITK ERROR: Class(0x...): " prefix.
+    std::string       text = e.GetDescription();
+    const std::string prefix = std::string("ITK ERROR: ") + filter.GetNameOfClass() + "(";
+    if (text.rfind(prefix, 0) == 0)
+      if (const auto end = text.find("): "); end != std::string::npos)
+        text = text.substr(end + 3);
+    throw Error(text);
+  }
+}
+} // namespace morea::cli
