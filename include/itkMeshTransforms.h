@@ -147,7 +147,7 @@ struct OriginalFrameTransforms
 /** Composes `fields` with the pre-alignment `rigid` (null: none). The
  *  composites hold fresh field transforms (without inverse fields). */
 OriginalFrameTransforms
-MakeOriginalFrameTransforms(const MeshFields & fields, const RigidTransformType * rigid);
+MakeOriginalFrameTransforms(const MeshFields & fields, const PreAlignmentTransformType * rigid);
 
 /** Writes the two transforms between the original images as ITK transform
  *  files (.h5 or .tfm; antsApplyTransforms, 3D Slicer and SimpleITK read

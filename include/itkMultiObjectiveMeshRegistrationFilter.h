@@ -90,7 +90,10 @@ public:
   using MovingImageType = TMovingImage;
   using InternalImageType = morea::ImageType;
   using MaskType = morea::MaskType;
-  using RigidTransformType = morea::RigidTransformType;
+  using RigidTransformType = morea::PreAlignmentTransformType;
+  /** A transform given to pre-align the moving image (SetInitialMovingTransform). */
+  using InitialTransformType = TransformBaseTemplate<double>;
+  using DecoratedInitialTransformType = DataObjectDecorator<InitialTransformType>;
   using DisplacementFieldTransformType = morea::DisplacementFieldTransformType;
   using ParameterSetType = ::morea::ParameterSet;
   using GenerationRecordType = ::morea::GenerationRecord;
@@ -156,6 +159,16 @@ public:
   itkGetInputMacro(FixedLandmarks, PointSetType);
   itkSetInputMacro(MovingLandmarks, PointSetType);
   itkGetInputMacro(MovingLandmarks, PointSetType);
+
+  /** Optional pre-alignment of the moving image, used instead of the rigid
+   *  step on preprocess_rigid_structure: a linear 3D transform (rigid,
+   *  similarity, affine: e.g. read from an ITK, ANTs or 3D Slicer transform
+   *  file) that maps fixed points to moving points, as ResampleImageFilter
+   *  uses it. Any other transform fails at Update() with a message. */
+  virtual void
+  SetInitialMovingTransform(const InitialTransformType * transform);
+  const InitialTransformType *
+  GetInitialMovingTransform() const;
 
   /** Optional masks of the body on each image's grid; voxels outside are background. */
   itkSetInputMacro(FixedBodyMask, MaskType);
@@ -278,7 +291,8 @@ public:
   const DisplacementFieldTransformType *
   GetPreprocessedMovingToFixedTransform(SizeValueType i) const;
 
-  /** Rigid pre-alignment: preprocessed frame (fixed physical space) -> original moving image. */
+  /** The pre-alignment (rigid, the initial transform given, or the identity):
+   *  preprocessed frame (fixed physical space) -> original moving image. */
   const DecoratedRigidTransformType *
   GetRigidTransformOutput() const;
   const RigidTransformType *

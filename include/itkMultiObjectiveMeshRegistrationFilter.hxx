@@ -7,6 +7,7 @@
 #ifndef itkMultiObjectiveMeshRegistrationFilter_hxx
 #define itkMultiObjectiveMeshRegistrationFilter_hxx
 
+#include "itkAffineTransform.h"
 #include "itkCastImageFilter.h"
 #include "itkMultiObjectiveMeshRegistrationFilter.h"
 
@@ -75,6 +76,7 @@ MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::MultiObjectiveM
   Self::SetInput("FixedBodyMask", nullptr);
   Self::SetInput("MovingBodyMask", nullptr);
   Self::SetInput("FixedLandmarks", nullptr);
+  Self::SetInput("InitialMovingTransform", nullptr);
   Self::SetInput("MovingLandmarks", nullptr);
 
   // The approximation set and the rigid transform always exist; the chosen
@@ -226,6 +228,33 @@ MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::SetBackend(cons
 
 template <typename TFixedImage, typename TMovingImage>
 void
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::SetInitialMovingTransform(
+  const InitialTransformType * transform)
+{
+  if (transform == this->GetInitialMovingTransform())
+    return;
+  typename DecoratedInitialTransformType::Pointer decorated;
+  if (transform)
+  {
+    decorated = DecoratedInitialTransformType::New();
+    decorated->Set(transform);
+  }
+  this->ProcessObject::SetInput("InitialMovingTransform", decorated);
+  this->Modified();
+}
+
+template <typename TFixedImage, typename TMovingImage>
+auto
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GetInitialMovingTransform() const
+  -> const InitialTransformType *
+{
+  const auto * decorated =
+    dynamic_cast<const DecoratedInitialTransformType *>(this->ProcessObject::GetInput("InitialMovingTransform"));
+  return decorated ? decorated->Get() : nullptr;
+}
+
+template <typename TFixedImage, typename TMovingImage>
+void
 MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::SetRefusalBounds(const std::string & choice)
 {
   try
@@ -365,7 +394,7 @@ MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::MakeOutput(Data
   }
   if (idx == 1)
   {
-    auto rigid = RigidTransformType::New();
+    auto rigid = morea::RigidTransformType::New();
     rigid->SetIdentity();
     auto decorator = DecoratedRigidTransformType::New();
     decorator->Set(rigid);
@@ -503,7 +532,44 @@ MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GenerateData()
       this->UpdateProgress(static_cast<float>(fraction));
       stopIfAborted();
     };
-    run = morea::RunMultiObjectiveRegistration(problem, m_Parameters, options, m_Selection, progress);
+    const morea::PreAlignmentTransformType * initial = nullptr;
+    morea::PreAlignmentTransformType::Pointer convertedInitial;
+    if (const InitialTransformType * given = this->GetInitialMovingTransform())
+    {
+      if (given->GetInputSpaceDimension() != 3 || given->GetOutputSpaceDimension() != 3)
+      {
+        itkExceptionMacro("initial moving transform: " << given->GetNameOfClass() << " maps "
+                                                       << given->GetInputSpaceDimension() << "-D points to "
+                                                       << given->GetOutputSpaceDimension()
+                                                       << "-D points; a 3-D transform is needed");
+      }
+      initial = dynamic_cast<const morea::PreAlignmentTransformType *>(given);
+      if (!initial)
+      {
+        // Other linear transforms (a translation, say) as the affine map they are.
+        const auto * linear = dynamic_cast<const Transform<double, 3, 3> *>(given);
+        if (!linear || linear->GetTransformCategory() != Transform<double, 3, 3>::TransformCategoryEnum::Linear)
+        {
+          itkExceptionMacro("initial moving transform: " << given->GetNameOfClass()
+                                                         << " is not linear; give a translation, rigid, similarity "
+                                                            "or affine transform");
+        }
+        typename Transform<double, 3, 3>::InputPointType origin;
+        origin.Fill(0.0);
+        typename Transform<double, 3, 3>::JacobianPositionType jacobian;
+        linear->ComputeJacobianWithRespectToPosition(origin, jacobian);
+        auto                             affine = AffineTransform<double, 3>::New();
+        AffineTransform<double, 3>::MatrixType matrix;
+        for (unsigned r = 0; r < 3; ++r)
+          for (unsigned c = 0; c < 3; ++c)
+            matrix(r, c) = jacobian(r, c);
+        affine->SetMatrix(matrix);
+        affine->SetOffset(linear->TransformPoint(origin) - origin);
+        convertedInitial = affine;
+        initial = affine;
+      }
+    }
+    run = morea::RunMultiObjectiveRegistration(problem, m_Parameters, options, m_Selection, progress, initial);
   }
   catch (const ExceptionObject &)
   {

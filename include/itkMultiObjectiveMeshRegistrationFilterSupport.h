@@ -102,7 +102,8 @@ constexpr double OptimisationProgressEnd = 0.95;
 void
 CheckSingleRunParameters(const ::morea::ParameterSet & parameters);
 
-/** Validates `problem`, preprocesses it, runs MOREA and rasterises the
+/** Validates `problem`, preprocesses it (pre-aligned by `initialTransform`
+ *  when given, else as the parameters say), runs MOREA and rasterises the
  *  solutions `selection` names on the preprocessed grid. The CUDA device and
  *  its lowest compute level come from the parameters (cuda_gpu_id,
  *  cuda_compute_level). `progress` (may be empty) gets the cumulative
@@ -111,7 +112,8 @@ CheckSingleRunParameters(const ::morea::ParameterSet & parameters);
 MultiObjectiveRegistrationRun
 RunMultiObjectiveRegistration(const RegistrationProblem & problem, const ::morea::ParameterSet & parameters,
                               const MeshRegistrationOptions & options, const std::string & selection,
-                              const std::function<void(double)> & progress);
+                              const std::function<void(double)> & progress,
+                              const PreAlignmentTransformType * initialTransform = nullptr);
 
 /** Prints the explicitly set parameters and the main run keys, one per line. */
 void

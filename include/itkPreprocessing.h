@@ -34,6 +34,9 @@ struct PreprocessOptions
   float       windowMin{ -1000.0f };    ///< maps to the lowest foreground value
   float       windowMax{ 1000.0f };     ///< maps to 1
   float       fieldOfViewThreshold{ -1024.0f }; ///< raw values below are outside the scanner's view
+  /** A pre-alignment given (fixed point -> moving point), used instead of the
+   *  rigid step on `rigidStructure`; null: none. Must be invertible. */
+  PreAlignmentTransformType::ConstPointer initialTransform;
 
   static PreprocessOptions
   FromParameters(const ::morea::ParameterSet & parameters);
@@ -45,7 +48,8 @@ constexpr float ForegroundFloor = 1.0e-3f;
 
 struct PreprocessReport
 {
-  std::string                 rigidStructure;   ///< "" when skipped
+  std::string                 rigidStructure;   ///< "" when skipped or when a transform was given
+  std::string                 initialTransform; ///< the class of the transform given, "" when none
   RigidAlignmentResult        rigid;            ///< identity when skipped
   std::string                 cropStructure;
   std::vector<std::string>    droppedStructures; ///< no voxel left inside the crop
@@ -63,7 +67,7 @@ struct PreprocessResult
   RegistrationProblem problem;
   /** Rigid map from the preprocessed frame to the original moving image
    *  (fixed point -> moving point), to compose with later deformations. */
-  RigidTransformType::Pointer rigidTransform;
+  PreAlignmentTransformType::Pointer rigidTransform;
   PreprocessReport            report;
 };
 
@@ -80,7 +84,8 @@ ResampleIsotropic(const ImageType * image, double spacing);
  *  linear interpolation of the mask's signed distance map, so structures drawn
  *  slice by slice become smooth 3D shapes without between-slice gaps. */
 MaskType::Pointer
-ResampleMask(const MaskType * mask, const ImageBase<Dimension> * grid, const RigidTransformType * gridToMask = nullptr);
+ResampleMask(const MaskType * mask, const ImageBase<Dimension> * grid,
+             const PreAlignmentTransformType * gridToMask = nullptr);
 
 /** The structure whose volume differs most between the images (ratio of the
  *  larger to the smaller volume), skipping "body"; "" when there is none. */
@@ -91,7 +96,7 @@ LargestDeformingStructure(const RegistrationProblem & problem);
  *  `maskToFrame` is given the box is of the mask mapped into that frame. */
 void
 MaskBoundingBox(const MaskType * mask, PointType & lower, PointType & upper,
-                const RigidTransformType * frameToMask = nullptr);
+                const PreAlignmentTransformType * frameToMask = nullptr);
 
 /** Windows `image` to [ForegroundFloor, 1]; voxels where `foreground` is 0 become exactly 0. */
 ImageType::Pointer

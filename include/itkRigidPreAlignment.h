@@ -23,6 +23,9 @@ namespace itk
 namespace morea
 {
 using RigidTransformType = VersorRigid3DTransform<double>;
+/** The pre-alignment of the moving image: the rigid transform found, or a
+ *  linear one given (affine, similarity, rigid), fixed point -> moving point. */
+using PreAlignmentTransformType = MatrixOffsetTransformBase<double, Dimension, Dimension>;
 
 struct RigidAlignmentOptions
 {
@@ -58,7 +61,7 @@ AlignRigidly(const MaskType * fixedMask, const MaskType * movingMask, const Rigi
 
 /** Writes the transform as an ITK transform file (.tfm, .h5, .mat), atomically. */
 void
-WriteRigidTransform(const RigidTransformType * transform, const std::string & path);
+WriteRigidTransform(const PreAlignmentTransformType * transform, const std::string & path);
 
 } // namespace morea
 } // namespace itk

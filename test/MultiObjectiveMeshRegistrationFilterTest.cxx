@@ -1,6 +1,8 @@
 // itk::MultiObjectiveMeshRegistrationFilter on a small synthetic problem: a
 // bladder that grows from 8 to 11 mm radius and a bone that stays put.
+#include "itkAffineTransform.h"
 #include "itkCommand.h"
+#include "itkTranslationTransform.h"
 #include "itkImageRegionIteratorWithIndex.h"
 #include "itkMultiObjectiveMeshRegistrationFilter.h"
 #include "itkRegistrationEvaluation.h"
@@ -577,4 +579,60 @@ TEST(MultiObjectiveMeshRegistrationFilter, RunsOnTheGpuByDefaultWhenOneIsPresent
   std::ostringstream printed;
   filter->Print(printed);
   EXPECT_NE(printed.str().find("BackendUsed: " + filter->GetBackendUsed()), std::string::npos) << printed.str();
+}
+
+TEST(MultiObjectiveMeshRegistrationFilter, AnInitialMovingTransformReplacesTheRigidStep)
+{
+  itk::Vector<double, 3> shift;
+  shift[0] = 4.0;
+  shift[1] = -2.0;
+  shift[2] = 2.0;
+  const ShiftedProblem problem(shift);
+  // A translation (linear, not a matrix-offset transform) and an affine: both pre-align as given.
+  auto translation = itk::TranslationTransform<double, 3>::New();
+  translation->SetOffset(shift);
+  auto affine = itk::AffineTransform<double, 3>::New();
+  affine->SetTranslation(shift);
+  for (const itk::TransformBaseTemplate<double> * initial :
+       { static_cast<const itk::TransformBaseTemplate<double> *>(translation.GetPointer()),
+         static_cast<const itk::TransformBaseTemplate<double> *>(affine.GetPointer()) })
+  {
+    auto filter = MakeFilter(problem);
+    filter->SetParameter("preprocess_rigid_structure", "bones"); // not used: the transform given wins
+    filter->SetInitialMovingTransform(initial);
+    ASSERT_NO_THROW(filter->Update()) << initial->GetNameOfClass();
+    EXPECT_EQ(filter->GetPreprocessReport().rigidStructure, "");
+    EXPECT_FALSE(filter->GetPreprocessReport().initialTransform.empty());
+    EXPECT_LT(filter->GetRigidTransform()->TransformPoint(BoneCentre()).EuclideanDistanceTo(BoneCentre() + shift),
+              1e-9);
+    // The composites start from it: the bone's centre maps onto the moving bone's.
+    EXPECT_LT(filter->GetFixedToMovingTransform(0)->TransformPoint(BoneCentre()).EuclideanDistanceTo(BoneCentre() + shift),
+              2.0);
+  }
+}
+
+TEST(MultiObjectiveMeshRegistrationFilter, InitialTransformsThatCannotPreAlignAreRefused)
+{
+  const Problem problem;
+  {
+    auto filter = MakeFilter(problem);
+    filter->SetInitialMovingTransform(itk::AffineTransform<double, 2>::New());
+    EXPECT_NE(UpdateError(filter).find("maps 2-D points to 2-D points; a 3-D transform is needed"), std::string::npos)
+      << UpdateError(filter);
+  }
+  {
+    auto filter = MakeFilter(problem);
+    auto field = itk::DisplacementFieldTransform<double, 3>::New();
+    filter->SetInitialMovingTransform(field);
+    EXPECT_NE(UpdateError(filter).find("is not linear"), std::string::npos) << UpdateError(filter);
+  }
+  {
+    auto filter = MakeFilter(problem);
+    auto singular = itk::AffineTransform<double, 3>::New();
+    auto matrix = singular->GetMatrix();
+    matrix(2, 2) = 0.0;
+    singular->SetMatrix(matrix);
+    filter->SetInitialMovingTransform(singular);
+    EXPECT_NE(UpdateError(filter).find("not invertible"), std::string::npos) << UpdateError(filter);
+  }
 }

@@ -26,7 +26,7 @@ namespace
  *  the rigid map R, so u(x) = R^-1(T(x)) - x and v(y) = T^-1(R(y)) - y. */
 itk::morea::DisplacementFieldType::Pointer
 TrueField(const PelvisPhantom & phantom, const itk::morea::RegistrationProblem & problem,
-          const itk::morea::RigidTransformType * rigid, bool fixedToMoving)
+          const itk::morea::PreAlignmentTransformType * rigid, bool fixedToMoving)
 {
   using namespace itk::morea;
   auto       field = MakeIdentityField(problem.fixedImage);

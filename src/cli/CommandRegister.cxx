@@ -33,12 +33,14 @@ struct Options
   std::optional<std::size_t> device;
   std::size_t                killAfter{ 0 };
   std::string                refusalBound{ "auto" };
+  std::string                initialTransform;
 };
 
 /** One registration through the filter, its folder written and its scores printed. */
 void
 RegisterOnce(const itk::morea::RegistrationProblem & input, const ParameterSet & parameters, const Options & options,
-             const std::string & folder, const CommandTimes & times)
+             const RegistrationFilterType::InitialTransformType * initialTransform, const std::string & folder,
+             const CommandTimes & times)
 {
   const bool createdFolder = std::filesystem::create_directories(folder);
   FilterSettings settings;
@@ -49,6 +51,7 @@ RegisterOnce(const itk::morea::RegistrationProblem & input, const ParameterSet &
   settings.checkpointFile = folder + "/checkpoint.bin";
   settings.checkpointInterval = options.checkpointEvery;
   settings.resume = options.resume;
+  settings.initialTransform = initialTransform;
   settings.onGeneration = [print = ProgressPrinter(), killAfter = options.killAfter](
                             const ::morea::GenerationRecord & r, std::size_t total) {
     print(r, total);
@@ -73,7 +76,9 @@ RegisterOnce(const itk::morea::RegistrationProblem & input, const ParameterSet &
   const auto & result = run.registration;
   std::cout << "preprocessed: " << r.size[0] << "x" << r.size[1] << "x" << r.size[2] << " voxels of " << r.spacing
             << " mm around '" << r.cropStructure << "'"
-            << (r.rigidStructure.empty() ? std::string() : ", rigid on '" + r.rigidStructure + "'") << "\n";
+            << (r.rigidStructure.empty() ? std::string() : ", rigid on '" + r.rigidStructure + "'")
+            << (r.initialTransform.empty() ? std::string() : ", pre-aligned by the " + r.initialTransform + " given")
+            << "\n";
   if (!r.rigid.intensitySkipped.empty())
     std::cout << "note: rigid pre-alignment without its intensity stage: " << r.rigid.intensitySkipped << "\n";
   if (result.resumedAtGeneration > 0)
@@ -134,6 +139,10 @@ AddRegisterCommand(CLI::App & app)
     ->check(CLI::IsMember({ "auto", "cuda", "cuda-texture", "cuda-exact", "cpu" }))
     ->capture_default_str();
   cmd->add_option("--device", options->device, "CUDA device ordinal (sets cuda_gpu_id)");
+  cmd->add_option("--initial-transform", options->initialTransform,
+                  "a linear transform (ITK .tfm/.h5/.txt, ANTs .mat, 3D Slicer) mapping fixed points to moving "
+                  "points, used instead of the rigid pre-alignment")
+    ->check(CLI::ExistingFile);
   cmd->add_option("--refusal-bound", options->refusalBound,
                   "skip sampling candidates that a lower bound of their objectives shows refused: on, off, or auto "
                   "(on with the cpu backend; the same result either way)")
@@ -154,6 +163,9 @@ AddRegisterCommand(CLI::App & app)
     if (options->backend != "cpu")
       warmUp.emplace(static_cast<int>(parameters.GetInteger("cuda_gpu_id")));
     itk::morea::CheckSolutionSelection(options->select); // before a long run, not after
+    RegistrationFilterType::InitialTransformType::Pointer initialTransform;
+    if (!options->initialTransform.empty())
+      initialTransform = ReadTransformFile(options->initialTransform);
     const auto   input = options->problem.Load();
     const double secondsLoad = std::chrono::duration<double>(Clock::now() - started).count();
 
@@ -176,7 +188,7 @@ AddRegisterCommand(CLI::App & app)
       if (runs > 1)
         std::cout << "run " << k + 1 << " of " << runs << " (seed " << run.GetInteger("seed") << ") in " << folder
                   << "\n";
-      RegisterOnce(input, run, *options, folder, { started, secondsLoad });
+      RegisterOnce(input, run, *options, initialTransform, folder, { started, secondsLoad });
     }
     if (zip)
     {

@@ -1,6 +1,7 @@
 #include "FilterRun.h"
 
 #include "itkCommand.h"
+#include "itkTransformFileReader.h"
 #include "morea/Error.h"
 
 #include <algorithm>
@@ -61,6 +62,7 @@ MakeRegistrationFilter(const itk::morea::RegistrationProblem & problem, const Pa
   filter->SetCheckpointFile(settings.checkpointFile);
   filter->SetCheckpointInterval(settings.checkpointInterval);
   filter->SetResume(settings.resume);
+  filter->SetInitialMovingTransform(settings.initialTransform);
   if (settings.onGeneration)
   {
     RegistrationFilterType * f = filter.GetPointer(); // the filter owns the observer: no cycle
@@ -69,6 +71,26 @@ MakeRegistrationFilter(const itk::morea::RegistrationProblem & problem, const Pa
     });
   }
   return filter;
+}
+
+RegistrationFilterType::InitialTransformType::Pointer
+ReadTransformFile(const std::string & path)
+{
+  auto reader = itk::TransformFileReaderTemplate<double>::New();
+  reader->SetFileName(path);
+  try
+  {
+    reader->Update();
+  }
+  catch (const itk::ExceptionObject & e)
+  {
+    throw Error("cannot read the transform file '" + path + "': " + e.GetDescription());
+  }
+  const auto * list = reader->GetTransformList();
+  if (list->size() != 1)
+    throw Error("the transform file '" + path + "' holds " + std::to_string(list->size()) +
+                " transforms; one linear transform is needed");
+  return list->front();
 }
 
 void

@@ -24,6 +24,8 @@ struct FilterSettings
   std::string checkpointFile; ///< empty: none
   std::size_t checkpointInterval{ 0 };
   bool        resume{ false };
+  /** Pre-alignment given instead of the rigid step; null: none. */
+  RegistrationFilterType::InitialTransformType::ConstPointer initialTransform;
   /** After each generation run (not the ones restored from a checkpoint). */
   std::function<void(const ::morea::GenerationRecord &, std::size_t generations)> onGeneration;
 };
@@ -34,6 +36,11 @@ struct FilterSettings
 RegistrationFilterType::Pointer
 MakeRegistrationFilter(const itk::morea::RegistrationProblem & problem, const ParameterSet & parameters,
                        const FilterSettings & settings);
+
+/** The one transform in an ITK transform file (.tfm, .txt, .h5, ANTs .mat);
+ *  throws morea::Error naming the file otherwise. */
+RegistrationFilterType::InitialTransformType::Pointer
+ReadTransformFile(const std::string & path);
 
 /** Updates the filter; its ITK exceptions become morea::Error with the
  *  filter's description (no source location), as the CLI prints them. */

@@ -81,7 +81,7 @@ MakeSpecs()
     Text("morea_elasticity_factors", "bones=10, bladder=0.5", {},
          "tissue elasticity factors of the deformation magnitude, structure=factor (others: 1)"),
     Int("morea_max_num_mesh_levels", 1, 1, 1, "mesh levels (single resolution only)"),
-    Int("morea_num_generations_per_level", 0, 0, 1e7, "generations per mesh level"),
+    Int("morea_num_generations_per_level", 0, 0, 0, "generations per mesh level (single resolution: 0)"),
     Text("morea_magnitude_metric", "biomechanical", { "biomechanical", "standard" },
          "deformation magnitude: with or without tissue elasticity factors"),
     Text("morea_image_metric", "squared-differences", { "squared-differences" }, "intensity objective"),

@@ -342,7 +342,7 @@ WriteMeshVtu(const std::string & path, const ::morea::MeshTopology & topology,
 }
 
 OriginalFrameTransforms
-MakeOriginalFrameTransforms(const MeshFields & fields, const RigidTransformType * rigid)
+MakeOriginalFrameTransforms(const MeshFields & fields, const PreAlignmentTransformType * rigid)
 {
   // CompositeTransform applies the transform added last first.
   OriginalFrameTransforms out{ CompositeTransformType::New(), CompositeTransformType::New() };
@@ -353,18 +353,15 @@ MakeOriginalFrameTransforms(const MeshFields & fields, const RigidTransformType 
   v->SetDisplacementField(fields.movingToFixed);
   if (rigid)
   {
-    auto copy = RigidTransformType::New();
-    copy->SetFixedParameters(rigid->GetFixedParameters());
-    copy->SetParameters(rigid->GetParameters());
-    out.fixedToMoving->AddTransform(copy);
+    out.fixedToMoving->AddTransform(rigid->Clone());
   }
   out.fixedToMoving->AddTransform(u);
   out.movingToFixed->AddTransform(v);
   if (rigid)
   {
-    auto inverse = RigidTransformType::New();
-    if (!rigid->GetInverse(inverse))
-      itkGenericExceptionMacro("the rigid pre-alignment is not invertible");
+    const auto inverse = rigid->GetInverseTransform();
+    if (!inverse)
+      itkGenericExceptionMacro("the pre-alignment is not invertible");
     out.movingToFixed->AddTransform(inverse);
   }
   return out;

@@ -160,7 +160,8 @@ CheckSingleRunParameters(const ::morea::ParameterSet & parameters)
 MultiObjectiveRegistrationRun
 RunMultiObjectiveRegistration(const RegistrationProblem & problem, const ::morea::ParameterSet & parameters,
                               const MeshRegistrationOptions & options, const std::string & selection,
-                              const std::function<void(double)> & progress)
+                              const std::function<void(double)> & progress,
+                              const PreAlignmentTransformType * initialTransform)
 {
   using Clock = std::chrono::steady_clock;
   const auto secondsSince = [](Clock::time_point t) {
@@ -187,7 +188,9 @@ RunMultiObjectiveRegistration(const RegistrationProblem & problem, const ::morea
 
   MultiObjectiveRegistrationRun run;
   auto                          stage = Clock::now();
-  run.preprocessed = Preprocess(problem, PreprocessOptions::FromParameters(parameters));
+  PreprocessOptions preprocessing = PreprocessOptions::FromParameters(parameters);
+  preprocessing.initialTransform = initialTransform;
+  run.preprocessed = Preprocess(problem, preprocessing);
   run.secondsPreprocessing = secondsSince(stage);
   report(PreprocessingProgressShare);
 

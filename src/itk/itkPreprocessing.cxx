@@ -117,7 +117,7 @@ MakeImageOn(const ImageBase<Dimension> * grid)
 }
 
 ImageType::Pointer
-ResampleLinear(const ImageType * image, const ImageBase<Dimension> * grid, const RigidTransformType * gridToImage,
+ResampleLinear(const ImageType * image, const ImageBase<Dimension> * grid, const PreAlignmentTransformType * gridToImage,
                float defaultValue)
 {
   using FilterType = ResampleImageFilter<ImageType, ImageType>;
@@ -189,7 +189,7 @@ ResampleIsotropic(const ImageType * image, double spacing)
 }
 
 MaskType::Pointer
-ResampleMask(const MaskType * mask, const ImageBase<Dimension> * grid, const RigidTransformType * gridToMask)
+ResampleMask(const MaskType * mask, const ImageBase<Dimension> * grid, const PreAlignmentTransformType * gridToMask)
 {
   auto                output = MakeImageOn<MaskType>(grid);
   MaskType::IndexType lo, hi;
@@ -223,12 +223,13 @@ ResampleMask(const MaskType * mask, const ImageBase<Dimension> * grid, const Rig
 }
 
 void
-MaskBoundingBox(const MaskType * mask, PointType & lower, PointType & upper, const RigidTransformType * frameToMask)
+MaskBoundingBox(const MaskType * mask, PointType & lower, PointType & upper,
+                const PreAlignmentTransformType * frameToMask)
 {
   MaskType::IndexType lo, hi;
   if (!InsideIndexBox(mask, lo, hi))
     Fail("cannot take the bounding box of an empty mask");
-  RigidTransformType::InverseTransformBasePointer maskToFrame;
+  PreAlignmentTransformType::InverseTransformBasePointer maskToFrame;
   if (frameToMask != nullptr)
     maskToFrame = frameToMask->GetInverseTransform();
   for (unsigned d = 0; d < Dimension; ++d)
@@ -346,10 +347,18 @@ Preprocess(const RegistrationProblem & input, const PreprocessOptions & options)
   PreprocessResult result;
   auto &           report = result.report;
 
-  // 1. Rigid pre-alignment (moving onto fixed) on the chosen structure.
-  auto rigid = RigidTransformType::New();
+  // 1. Pre-alignment (moving onto fixed): the transform given, or rigid on the chosen structure.
+  PreAlignmentTransformType::Pointer rigid = RigidTransformType::New();
   rigid->SetIdentity();
-  if (!options.rigidStructure.empty() && options.rigidStructure != "none")
+  if (options.initialTransform)
+  {
+    if (!options.initialTransform->GetInverseTransform())
+      Fail(std::string("the initial moving transform (") + options.initialTransform->GetNameOfClass() +
+           ") is not invertible");
+    rigid = options.initialTransform->Clone();
+    report.initialTransform = options.initialTransform->GetNameOfClass();
+  }
+  else if (!options.rigidStructure.empty() && options.rigidStructure != "none")
   {
     const Structure & s = input.GetStructure(options.rigidStructure);
     if (s.fixedMask.IsNull() || s.movingMask.IsNull())

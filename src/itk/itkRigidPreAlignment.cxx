@@ -292,7 +292,7 @@ AlignRigidly(const MaskType * fixedMask, const MaskType * movingMask, const Rigi
 }
 
 void
-WriteRigidTransform(const RigidTransformType * transform, const std::string & path)
+WriteRigidTransform(const PreAlignmentTransformType * transform, const std::string & path)
 {
   const std::string tmp = TemporaryPathFor(path);
   auto              writer = TransformFileWriterTemplate<double>::New();

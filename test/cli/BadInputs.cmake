@@ -398,6 +398,12 @@ expect_failure("benchmark: start from a damaged checkpoint" OUTPUTS "${WORK}/ben
   ARGS benchmark --fixed "${fixed}" --moving "${moving}" ${blob} --set ea_population_size=8 --set ea_num_clusters=2
        --set morea_mesh_num_points=40 --set preprocess_rigid_structure=none --backends cpu --probe 0
        --from-checkpoint "${WORK}/benchmark-bad-checkpoint.bin" -o "${WORK}/benchmark-out.json")
+file(WRITE "${WORK}/initial-2d.tfm" "#Insight Transform File V1.0\n#Transform 0\nTransform: AffineTransform_double_2_2\n"
+  "Parameters: 1 0 0 1 0 0\nFixedParameters: 0 0\n")
+expect_failure("register: a 2-D initial transform" OUTPUTS ${o} FRAGMENTS "initial moving transform" "3-D transform"
+  ARGS register --fixed "${fixed}" --moving "${moving}" ${blob} --set ea_population_size=8 --set ea_num_clusters=2
+       --set ea_num_generations=1 --set morea_mesh_num_points=40 --set preprocess_rigid_structure=none
+       --initial-transform "${WORK}/initial-2d.tfm" --backend cpu -o "${o}")
 # Without a GPU (as on CI), a CUDA backend asked for by name fails before any output is written.
 if(NOT EXISTS "/dev/nvidia0")
   expect_failure("register: CUDA without a device" OUTPUTS ${o} FRAGMENTS "backend 'cuda'" "backend auto"

@@ -258,6 +258,20 @@ expect_files("register"
   "${reg}/best_guidance/fixed_to_moving.h5" "${reg}/best_guidance/moving_to_fixed.h5"
   "${reg}/best_guidance/mesh_moving.vtu" "${reg}/best_guidance/mesh_fixed.vtu" "${reg}/best_guidance/scores.json"
   "${reg}/knee/fixed_to_moving.h5")
+# --- register --initial-transform: an affine file replaces the rigid step ----------------------------------
+file(WRITE "${WORK}/initial.tfm" "#Insight Transform File V1.0\n#Transform 0\nTransform: AffineTransform_double_3_3\n"
+  "Parameters: 1 0 0 0 1 0 0 0 1 4 -7 12\nFixedParameters: 0 0 0\n")
+execute_process(COMMAND "${MOREA}" register --problem "${phantom}" ${tiny} --set ea_num_generations=2
+  --initial-transform "${WORK}/initial.tfm" --select best-guidance -o "${WORK}/initial"
+  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0 OR NOT out MATCHES "pre-aligned by the AffineTransform given")
+  message(FATAL_ERROR "register --initial-transform (${rc}):\n${out}\n${err}")
+endif()
+file(READ "${WORK}/initial/rigid_fixed_to_moving.tfm" written)
+if(NOT written MATCHES "AffineTransform_double_3_3" OR NOT written MATCHES "Parameters: 1 0 0 0 1 0 0 0 1 4 -7 12")
+  message(FATAL_ERROR "register --initial-transform: the pre-alignment written is not the one given:\n${written}")
+endif()
+
 # --- register num_runs = 2, zip = true: two seeds in two folders, one archive ---------------------------
 set(runs "${WORK}/runs")
 file(REMOVE_RECURSE "${runs}" "${runs}.zip")
