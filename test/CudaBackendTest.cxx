@@ -121,7 +121,7 @@ TEST(CudaEvaluationBackend, WholeSolutionsAgreeWithTheCpu)
     population.push_back(folded);
     auto cpu = CreateCpuEvaluationBackend(*problem.evaluator, 2);
     auto cuda = CreateCudaEvaluationBackend(*problem.evaluator, 2);
-    EXPECT_EQ(cuda->Name(), "cuda");
+    EXPECT_EQ(cuda->Name(), "cuda-exact");
     const auto a = EvaluateAll(*cpu, population);
     const auto b = EvaluateAll(*cuda, population);
     for (std::size_t i = 0; i < population.size(); ++i)
@@ -600,7 +600,7 @@ TEST(CudaEvaluationBackend, TexturePathRefusesImagesTallerThanItsLayers)
     EXPECT_NE(std::string(e.what()).find("exceeds the texture path's limits"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("--backend cuda"), std::string::npos) << e.what();
   }
-  EXPECT_EQ(CreateCudaEvaluationBackend(*problem.evaluator, 2, CudaInterpolation::Exact)->Name(), "cuda");
+  EXPECT_EQ(CreateCudaEvaluationBackend(*problem.evaluator, 2, CudaInterpolation::Exact)->Name(), "cuda-exact");
 }
 
 // The texture path sizes each part's sampling without waiting for its number
@@ -746,7 +746,7 @@ TEST(EvaluationBackendSelection, NamesAndDeviceAbsence)
   else
   {
     EXPECT_EQ(CreateEvaluationBackend(BackendChoice::CudaTexture, *problem.evaluator, 1)->Name(), "cuda-texture");
-    EXPECT_EQ(CreateEvaluationBackend(BackendChoice::CudaExact, *problem.evaluator, 1)->Name(), "cuda");
+    EXPECT_EQ(CreateEvaluationBackend(BackendChoice::CudaExact, *problem.evaluator, 1)->Name(), "cuda-exact");
     // A compute level above any device's: refused by name, the CPU for auto.
     request.device = 0;
     request.minimumComputeLevel = 200;
@@ -1165,7 +1165,7 @@ TEST(CudaEvaluationBackend, TexturePathWithManyStructuresSamplesSkippedCandidate
 
 // Asked for, the texture path runs up to cuda::MaxTextureStructures (16)
 // structures and says nothing; with more, the backend runs the exact kernels
-// (named "cuda", agreeing with the CPU to the exact path's 1e-4) and says
+// (named "cuda-exact", agreeing with the CPU to the exact path's 1e-4) and says
 // which path it took and why, rather than falling back silently.
 TEST(CudaEvaluationBackend, TexturePathRunsUpToSixteenStructuresAndNamesItsFallback)
 {
@@ -1182,7 +1182,7 @@ TEST(CudaEvaluationBackend, TexturePathRunsUpToSixteenStructuresAndNamesItsFallb
   OptimiserTestProblem problem;
   problem.UseStructures(17);
   auto fallback = CreateCudaEvaluationBackend(*problem.evaluator, 2, CudaInterpolation::Texture);
-  EXPECT_EQ(fallback->Name(), "cuda");
+  EXPECT_EQ(fallback->Name(), "cuda-exact");
   const std::string note = fallback->PathNote();
   EXPECT_NE(note.find("exact CUDA kernels instead of the texture path"), std::string::npos) << note;
   EXPECT_NE(note.find("17 guidance structures"), std::string::npos) << note;

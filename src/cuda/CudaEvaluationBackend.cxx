@@ -10,11 +10,12 @@ CudaEvaluationBackend::CudaEvaluationBackend(const TetrahedronEvaluator & evalua
                                              CudaInterpolation interpolation, int device)
   : m_Evaluator(evaluator)
   , m_Pool(ThreadPool::Shared(threads))
+  , m_Device(device)
 {
   const std::string unavailable = CudaUnavailableReason();
   if (!unavailable.empty())
     throw Error("CUDA backend: " + unavailable);
-  Check(cudaSetDevice(device), ("selecting device " + std::to_string(device)).c_str());
+  SelectDevice();
   m_Stream = std::make_unique<cuda::Stream>();
   m_CopyStream = std::make_unique<cuda::Stream>();
   for (auto & stream : m_FoldStreams)
@@ -79,6 +80,7 @@ void
 CudaEvaluationBackend::EvaluateSolutions(const std::vector<const DualMesh *> & solutions,
                                          const std::vector<std::vector<TetrahedronValues> *> & values)
 {
+  SelectDevice();
   if (solutions.size() != values.size())
     throw Error("evaluation backend: as many value arrays as solutions are needed");
   const auto &      tets = m_Evaluator.Topology().Tetrahedra();
@@ -125,6 +127,7 @@ CudaEvaluationBackend::EvaluateSolutions(const std::vector<const DualMesh *> & s
 void
 CudaEvaluationBackend::SetFoldHandling(const FoldHandling & handling)
 {
+  SelectDevice();
   if (handling.repair && !handling.base)
     throw Error("evaluation backend: the fold repair needs the base mesh");
   EvaluationBackend::SetFoldHandling(handling);
@@ -168,6 +171,7 @@ void
 CudaEvaluationBackend::EvaluatePartials(const std::vector<PartialCandidate> & candidates, const ReadyCandidates & ready,
                                         const Meanwhile & meanwhile)
 {
+  SelectDevice();
   const auto        start = std::chrono::steady_clock::now();
   const int         slot = 1 - m_CurrentHost;
   HostCandidates &  host = m_HostCandidates[slot];
@@ -206,6 +210,7 @@ CudaEvaluationBackend::EvaluatePartials(const std::vector<PartialCandidate> & ca
 void
 CudaEvaluationBackend::PrepareNextPartials(const std::vector<PartialCandidate> & next)
 {
+  SelectDevice();
   const auto start = std::chrono::steady_clock::now();
   HostCandidates & host = m_HostCandidates[1 - m_CurrentHost];
   PackCandidates(next, host);
@@ -217,6 +222,7 @@ void
 CudaEvaluationBackend::StartNextPartials(const std::vector<PartialCandidate> & next, std::size_t head,
                                          const RefusalScreen * screen)
 {
+  SelectDevice();
   if (!WantsNextPartials() || head == 0 || head > next.size())
     return;
   const int        slot = 1 - m_CurrentHost;
@@ -237,6 +243,7 @@ void
 CudaEvaluationBackend::FetchValues(const std::vector<PartialCandidate> & candidates,
                                    const std::vector<std::size_t> & which)
 {
+  SelectDevice();
   const auto             start = std::chrono::steady_clock::now();
   const HostCandidates & h = m_HostCandidates[m_CurrentHost];
   BatchFlight &          f = *m_Flights[m_CurrentHost];
@@ -256,6 +263,7 @@ void
 CudaEvaluationBackend::SampleSkipped(const std::vector<PartialCandidate> & candidates,
                                      const std::vector<std::size_t> & which)
 {
+  SelectDevice();
   const auto                 start = std::chrono::steady_clock::now();
   const HostCandidates &     h = m_HostCandidates[m_CurrentHost];
   BatchFlight &              f = *m_Flights[m_CurrentHost];
@@ -427,6 +435,14 @@ CudaEvaluationBackend::UnpackSolutions(const BatchFlight & f, std::size_t n,
   });
   for (double count : samples)
     m_Statistics.samples += count;
+}
+
+void
+CudaEvaluationBackend::SelectDevice() const
+{
+  // The current device is per host thread: a backend called from another
+  // thread than the one that made it still runs on its own device.
+  Check(cudaSetDevice(m_Device), ("selecting CUDA device " + std::to_string(m_Device)).c_str());
 }
 } // namespace cudabackend
 

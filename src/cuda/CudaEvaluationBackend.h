@@ -268,7 +268,7 @@ public:
   std::string
   Name() const override
   {
-    return m_Constants.packed && m_Constants.interpolation == cuda::Interpolation::Texture ? "cuda-texture" : "cuda";
+    return m_Constants.packed && m_Constants.interpolation == cuda::Interpolation::Texture ? "cuda-texture" : "cuda-exact";
   }
 
   /** Why the texture path, asked for, does not run (more structures than it
@@ -673,7 +673,11 @@ private:
    *  first (see ChunkRoomPerItem). */
   double                        m_MostChunksPerItem{ -1.0 };
   cuda::EvaluationConstants     m_Constants;
+  /** Makes this backend's device current on the calling thread. */
+  void
+  SelectDevice() const;
   std::string                   m_PathNote; ///< see PathNote
+  int                           m_Device{ 0 }; ///< the CUDA device ordinal every call runs on
   cuda::DeviceArray<float>      m_Moving, m_Fixed, m_PackedMoving, m_PackedFixed;
   VolumeTextures m_MovingTextures, m_FixedTextures;
   cuda::DeviceArray<double>     m_GuidanceWeights, m_Elasticity, m_ReferenceVolumes;
