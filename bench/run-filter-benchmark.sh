@@ -7,7 +7,8 @@
 #                settings) and the test programs, and packs them with two
 #                problem folders into device-carry/: the abdominal CBCT pair
 #                (2 guidance structures) and the pelvis phantom split into 6
-#                guidance structures (bench/tools/phantom-six-structures.py).
+#                guidance structures (bench/tools/phantom-six-structures.py),
+#                also run with 2 of them guiding (the same grid).
 #   On the GPU:  bench/run-filter-benchmark.sh run OUTDIR [ROUNDS]
 #                runs the filter and CUDA tests, then per round and problem the
 #                example and `morea register` with the paper's configuration
@@ -37,8 +38,11 @@ case "${1:-}" in
     build/bin/morea phantom -o "$stage/phantom" >/dev/null
     "$python" bench/tools/phantom-six-structures.py "$stage/phantom" "$stage/phantom6"
     cp bench/configurations/abdomen_paper.toml bench/configurations/phantom6_paper.toml "$stage/"
+    # The same phantom and grid with 2 of its structures guiding.
+    { cat bench/configurations/phantom6_paper.toml; echo 'problem_guidance_selection = "bladder, rectum"'; } \
+      >"$stage/phantom2_paper.toml"
     scripts/device-bundle.sh --data "$a" --data "$stage/phantom6" --data "$stage/abdomen_paper.toml" \
-      --data "$stage/phantom6_paper.toml" \
+      --data "$stage/phantom6_paper.toml" --data "$stage/phantom2_paper.toml" \
       build/bin/morea build/bin/RegisterPelvisPhantom build/test/MOREAITKTests build/test/MOREACoreTests
     ;;
   run)
@@ -57,18 +61,20 @@ case "${1:-}" in
     tail -n 3 "$out/filter-tests.log" "$out/cuda-tests.log"
     echo "problem,program,round,seconds,backend" >"$out/runs.csv"
     for round in $(seq 1 "$rounds"); do
-      for problem in abdomen phantom6; do
+      for problem in abdomen phantom2 phantom6; do
         config="$D/${problem}_paper.toml"
+        folder="$D/$problem"
+        [ "$problem" = phantom2 ] && folder="$D/phantom6"
         for program in filter cli; do
           run="/tmp/runs/$problem-$program-$round"
           log="$out/$problem-$program-$round.log"
           rm -rf "$run"
           start=$(date +%s.%N)
           if [ "$program" = filter ]; then
-            "$B/RegisterPelvisPhantom" "$D/$problem" "$config" "$run" >"$log" 2>&1 || echo "failed: $log"
-            backend=$(grep -o '^evaluated on [a-z-]*' "$log" | awk '{print $3}')
+            "$B/RegisterPelvisPhantom" "$folder" "$config" "$run" >"$log" 2>&1 || echo "failed: $log"
+            backend=$(grep -o 'evaluated on [a-z-]*' "$log" | awk '{print $3}')
           else
-            "$B/morea" register --problem "$D/$problem" --parameters "$config" -o "$run" >"$log" 2>&1 ||
+            "$B/morea" register --problem "$folder" --parameters "$config" -o "$run" >"$log" 2>&1 ||
               echo "failed: $log"
             backend=$(grep -o '^backend: [a-z-]*' "$log" | awk '{print $2}')
           fi
@@ -91,7 +97,7 @@ for r in rows:
             voxels[r["problem"]] = int(m[1]) * int(m[2]) * int(m[3])
 lines = ["| problem | program | runs | median s | voxels | ns per voxel | backend |", "|---|---|---|---|---|---|---|"]
 per_voxel = {}
-for problem in ("abdomen", "phantom6"):
+for problem in ("abdomen", "phantom2", "phantom6"):
     for program in ("filter", "cli"):
         t = [float(r["seconds"]) for r in rows if r["problem"] == problem and r["program"] == program]
         if not t:
@@ -103,16 +109,17 @@ for problem in ("abdomen", "phantom6"):
         lines.append(f"| {problem} | {program} | {len(t)} | {med:.1f} | {v} | "
                      f"{med / v * 1e9:.1f} | {','.join(sorted(backend))} |" if v else f"| {problem} | {program} | {len(t)} | {med:.1f} | ? | ? | {backend} |")
 for program in ("filter", "cli"):
-    a, b = per_voxel.get(("abdomen", program)), per_voxel.get(("phantom6", program))
-    if a and b:
-        lines.append(f"\n{program}: 6-structure time per voxel / 2-structure = {b / a:.3f}")
+    for two in ("abdomen", "phantom2"):
+        a, b = per_voxel.get((two, program)), per_voxel.get(("phantom6", program))
+        if a and b:
+            lines.append(f"\n{program}: time per voxel, phantom6 / {two} = {b / a:.3f}")
 text = "\n".join(lines)
 open(f"{out}/summary.md", "w").write(text + "\n")
 print(text)
 PY
     ;;
   *)
-    sed -n '2,16p' "$0"
+    sed -n '2,18p' "$0"
     exit 2
     ;;
 esac

@@ -166,7 +166,9 @@ main(int argc, char * argv[])
     });
 
     filter->Update();
-    std::cout << "evaluated on " << filter->GetBackendUsed()
+    const auto registered = std::chrono::steady_clock::now();
+    std::cout << "registered in " << std::chrono::duration<double>(registered - started).count()
+              << " s from reading; evaluated on " << filter->GetBackendUsed()
               << (filter->GetBackendNote().empty() ? "" : " (" + filter->GetBackendNote() + ")") << "\n";
 
     fs::create_directories(output);

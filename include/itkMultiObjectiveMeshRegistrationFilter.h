@@ -48,7 +48,8 @@ namespace itk
  * otherwise; "cuda" insists on the GPU (an error without one), "cuda-exact"
  * is the GPU with software interpolation for verification, "cpu" the CPU.
  * SetDevice picks the CUDA device (the cuda_gpu_id key), and
- * SetNumberOfWorkUnits the host threads. GetBackendUsed() and
+ * SetNumberOfWorkUnits the host threads (at most the multi-threader's
+ * threads: all cores by default). GetBackendUsed() and
  * GetBackendNote() say where it ran and why; the log (itkDebugMacro) and
  * PrintSelf too.
  *
@@ -211,7 +212,8 @@ public:
    *  texture path when a usable CUDA device is present, else the CPU),
    *  "cuda" (the texture path; an error without a device), "cuda-exact"
    *  (software interpolation on the GPU, for verification) or "cpu".
-   *  Anything else throws. Host threads: SetNumberOfWorkUnits. */
+   *  Anything else throws. Host threads: SetNumberOfWorkUnits (at most
+   *  GetMultiThreader()->GetMaximumNumberOfThreads(), all cores by default). */
   virtual void
   SetBackend(const std::string & backend);
   itkGetConstReferenceMacro(Backend, std::string);

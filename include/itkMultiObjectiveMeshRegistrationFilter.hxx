@@ -509,7 +509,11 @@ MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GenerateData()
     options.checkpointPath = m_CheckpointFile;
     options.checkpointInterval = m_CheckpointInterval;
     options.resume = m_Resume;
-    options.threads = this->GetNumberOfWorkUnits();
+    // Host threads: the work units, but no more than the threader's threads
+    // (ITK's default work units are 4 per thread; the optimiser's pool wants
+    // one thread per core).
+    options.threads = std::max<SizeValueType>(
+      1, std::min<SizeValueType>(this->GetNumberOfWorkUnits(), this->GetMultiThreader()->GetMaximumNumberOfThreads()));
     options.backend = ::morea::ParseBackendChoice(m_Backend);
     options.refusalBounds = ::morea::ParseRefusalBoundChoice(m_RefusalBounds);
     // Between generations is the only point the run can stop at cleanly; both
