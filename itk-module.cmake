@@ -13,6 +13,7 @@ itk_module(MultiObjectiveRegistration
     ITKIOPNG
     ITKIOTransformBase
     ITKIOTransformHDF5
+    ITKIOTransformMatlab
     ITKImageGrid
     ITKImageIntensity
     ITKImageFunction

@@ -16,7 +16,8 @@ packages=(
   libpng-dev zlib1g-dev
   xz-utils                 # tests unpack the DICOM test archive
   elastix                  # comparison study (study/): elastix 5.0.1 and transformix
-  python3-venv python3-pip # comparison study: Python packages in a venv
+  python3-venv python3-pip # comparison study and the Python package's tests: packages in a venv
+  python3-dev pybind11-dev # the Python package (morea): its extension module
 )
 
 SUDO=""
