@@ -10,7 +10,7 @@ ctest --test-dir build --output-on-failure -j"$(nproc)"
 # The Python package as users install it: `pip install .` into a fresh venv,
 # then its tests against the installed package (they use build/bin/morea to
 # write the phantom).
-venv=build/pip-venv
+venv="$PWD/build/pip-venv"
 rm -rf "$venv"
 /usr/bin/python3 -m venv "$venv"
 "$venv/bin/python" -m pip install -q --disable-pip-version-check . SimpleITK pytest
