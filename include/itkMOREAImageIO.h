@@ -15,8 +15,11 @@ namespace morea
 {
 /** Reads a 3D scalar image in any format ITK reads (NIfTI, MetaImage, NRRD, ...).
  *  A directory is read as a DICOM series (GDCM; the first series found, slices
- *  sorted by position). The result is validated with ValidateImage(): a file
- *  that cannot be read, is not 3D, has non-positive spacing or NaN/inf voxels
+ *  sorted by position; slices unevenly spaced, e.g. one missing, or of mixed
+ *  orientations are an error). The result is validated with ValidateImage(): a
+ *  file that cannot be read, is not 3D, is truncated or holds another amount
+ *  of voxel data than its header describes (MetaImage, raw or compressed), has
+ *  non-positive spacing, a direction that is not orthonormal or NaN/inf voxels
  *  raises an ExceptionObject whose message names the file. */
 ImageType::Pointer
 ReadImage(const std::string & path);
@@ -39,7 +42,8 @@ std::map<std::string, unsigned int>
 ReadLabelNames(const std::string & path);
 
 /** Throws (naming `what`) when the image has non-positive or non-finite spacing,
- *  zero size, a singular direction matrix, or non-finite voxels. */
+ *  zero size, a singular direction matrix or one that is not orthonormal
+ *  within 1e-4 (a sheared or scaled grid), or non-finite voxels. */
 void
 ValidateImage(const ImageBase<Dimension> * image, const std::string & what);
 void

@@ -13,6 +13,7 @@
 #include "itkRegistrationProblem.h"
 #include "morea/EvaluationBackend.h"
 #include "morea/MoRvGomea.h"
+#include "morea/RunFingerprint.h"
 
 #include <functional>
 #include <string>
@@ -44,6 +45,12 @@ struct MeshRegistrationOptions
   /** Whether candidates that a bound shows refused go unsampled
    *  (morea/RefusalBound.h); the result is the same either way. */
   ::morea::RefusalBoundChoice refusalBounds{ ::morea::RefusalBoundChoice::Auto };
+  /** Entries the caller adds to the run's fingerprint (what the checkpoint
+   *  belongs to), before those RegisterMeshes adds itself: the parameters,
+   *  the preprocessed images, body masks and structures (RunFingerprintOf),
+   *  and the mesh. A resume whose fingerprint differs is refused, naming the
+   *  first key that differs. */
+  ::morea::RunFingerprint fingerprint;
   /** After each generation (also the resumed ones' replay is not called). May throw to abort. */
   std::function<void(const ::morea::GenerationRecord &, std::size_t generations)> onGeneration;
 };
@@ -72,6 +79,15 @@ struct MeshRegistrationResult
   double                                 secondsBackend{ 0.0 };       ///< the backend made (device set-up)
   double                                 secondsOptimisation{ 0.0 };
 };
+
+/** What the front of a run on the preprocessed `problem` depends on besides
+ *  the mesh: the parameters that can change it (all but bookkeeping, the
+ *  device and ea_num_generations: a resumed run may go on for longer), then
+ *  the images' grids and a hash of their voxels, the body masks, and each
+ *  structure's masks and points, in order. RegisterMeshes stores it in checkpoints; `morea benchmark
+ *  --from-checkpoint` gives the same. */
+::morea::RunFingerprint
+RunFingerprintOf(const RegistrationProblem & problem, const ::morea::ParameterSet & parameters);
 
 /** Registers a preprocessed problem (both images on one grid). */
 MeshRegistrationResult

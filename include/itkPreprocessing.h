@@ -53,6 +53,7 @@ struct PreprocessReport
   RigidAlignmentResult        rigid;            ///< identity when skipped
   std::string                 cropStructure;
   std::vector<std::string>    droppedStructures; ///< no voxel left inside the crop
+  std::vector<std::string>    droppedReasons;    ///< per dropped structure, why ("its moving mask has no voxel inside ...")
   ImageType::SizeType         size{ { 0, 0, 0 } };
   double                      spacing{ 0.0 };
   PointType                   origin;
@@ -73,6 +74,13 @@ struct PreprocessResult
 
 PreprocessResult
 Preprocess(const RegistrationProblem & input, const PreprocessOptions & options);
+
+/** Throws when a structure the registration would use (the guidance
+ *  structures of `parameters`: every structure but the body, or those named
+ *  in problem_guidance_selection) was dropped by preprocessing, with the
+ *  reason and the fix: a registration would otherwise run without it. */
+void
+CheckGuidanceStructuresKept(const PreprocessReport & report, const ::morea::ParameterSet & parameters);
 
 // The steps, usable alone.
 

@@ -51,7 +51,8 @@ public:
    *     (filled on the image grid; its contour points are kept)
    *   - a point set (elastix point file or CSV):  "bladder_points.txt"
    *  The image of that side must be loaded first. Masks on another grid are
-   *  resampled onto the image grid. Throws with the source in the message. */
+   *  resampled onto the image grid. Throws with the source in the message,
+   *  also when the side already has a mask (points) and `source` gives another. */
   void
   LoadStructure(const std::string & name, bool fixedSide, const std::string & source);
 
@@ -65,7 +66,9 @@ public:
 
   /** LoadStructure for each source, read side by side: a label map named by
    *  several sources is read once. Structures are added in the order of
-   *  `sources`; the first failure in that order is the one thrown. */
+   *  `sources`; the first failure in that order is the one thrown. One side
+   *  of a structure given two masks or two point sets (the same name twice)
+   *  is refused before anything is read. */
   void
   LoadStructures(const std::vector<StructureSource> & sources);
 
@@ -97,6 +100,11 @@ private:
   MaskType::Pointer
   LoadMask(const std::string & source, const ImageType * grid, PointListType * contourPoints,
            const LabelMapReader & readLabels = {}) const;
+  /** Throws when `sources` (with what is loaded already) give one side of a
+   *  structure two masks or two sets of points: the second would replace the
+   *  first without a word. */
+  void
+  CheckNoSideGivenTwice(const std::vector<StructureSource> & sources) const;
   /** The structure called `name`, added (empty) when there is none. */
   Structure &
   StructureNamed(const std::string & name);

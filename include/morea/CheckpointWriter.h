@@ -15,7 +15,8 @@
 
 namespace morea
 {
-/** Writes `bytes` to `path` atomically: to `path.partial`, then renamed, so
+/** Writes `bytes` to `path` atomically: to `path.partial`, synced (fsync),
+ *  then renamed and the folder synced, so
  *  that `path` holds either the old or the new file, never half of one.
  *  Throws Error (and leaves no partial file) when it cannot. */
 void

@@ -6,6 +6,7 @@
 #define morea_MeshGenerator_h
 
 #include "morea/TetrahedralMesh.h"
+#include "morea/Tetrahedralization.h"
 
 #include <cstdint>
 #include <map>
@@ -38,6 +39,9 @@ struct MeshGeneratorOptions
   std::vector<std::string>      surfaceStructures{ "bladder" };
   std::map<std::string, double> shares;                    ///< per structure, default 1
   std::uint64_t                 seed{ 0 };
+  /** How TetGen runs (by default each run in a child process, so that its
+   *  crash on bad surfaces drops the surfaces instead of ending the program). */
+  TetrahedralizationOptions     tetrahedralization;
 
   /** From morea_mesh_generation_method ("annotation-group-random-bladder-10":
    *  contour points, 10 % random points, surfaces of morea_mesh_surface_structures
@@ -62,7 +66,9 @@ struct MeshGenerationReport
   std::size_t                                       steinerPoints{ 0 };
   std::size_t                                       tetrahedra{ 0 };
   std::vector<std::pair<std::string, std::size_t>> pointsPerStructure;
-  std::vector<std::string>                          notes; ///< e.g. a surface that could not be used
+  /** e.g. a surface that could not be used, or a surface constraint dropped
+   *  because TetGen failed on it (and why) */
+  std::vector<std::string>                          notes;
   double                                            secondsPlacement{ 0.0 };
   double                                            secondsSurfaces{ 0.0 };
   double                                            secondsTetrahedralization{ 0.0 };

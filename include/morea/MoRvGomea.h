@@ -26,6 +26,7 @@
 #include "morea/FoldConstraint.h"
 #include "morea/ParallelStructure.h"
 #include "morea/Random.h"
+#include "morea/RunFingerprint.h"
 #include "morea/TetrahedralMesh.h"
 
 #include <array>
@@ -80,6 +81,10 @@ struct GomeaOptions
    *  otherwise 0. The result does not depend on it. */
   static constexpr std::size_t DrawAheadAutomatic = ~std::size_t{ 0 };
   std::size_t                  drawAheadThreads{ DrawAheadAutomatic };
+  /** What the front depends on beyond these options (inputs, preprocessing
+   *  and objective parameters; the caller knows them): stored in checkpoints,
+   *  and a checkpoint with another is refused. The optimiser adds the mesh. */
+  RunFingerprint fingerprint;
 
   /** ea_* keys, morea_repair_method and seed. */
   static GomeaOptions
@@ -204,8 +209,14 @@ public:
   Fitness
   EvaluateFully(const DualMesh & solution);
 
-  /** The whole optimiser state in a portable binary form, and back. Load
-   *  checks the checkpoint matches this problem (mesh and options). */
+  /** The whole optimiser state in a portable binary form, and back. The
+   *  file carries a checksum of its contents and the run's fingerprint
+   *  (GomeaOptions::fingerprint and the mesh). Load refuses, with a message
+   *  saying why and leaving the optimiser as it was, a file that is damaged
+   *  or truncated, of another fingerprint (naming the first key that
+   *  differs), of another mesh size or options, or whose contents are out of
+   *  range (a generation beyond ea_num_generations, counts that do not match
+   *  the mesh or population, ids beyond those given out). */
   void
   Save(std::ostream & out) const;
   void
@@ -216,16 +227,28 @@ public:
   CheckpointBytes() const;
   void
   CheckpointBytes(std::string & bytes) const;
-  /** Atomic: written to a temporary name, then renamed. */
+  /** Atomic: written to a temporary name, synced, then renamed. */
   void
   SaveCheckpoint(const std::string & path) const;
+  /** Load from a file; messages name it. */
   void
   LoadCheckpoint(const std::string & path);
+  /** The run's fingerprint as checkpoints store it: GomeaOptions::fingerprint
+   *  and the mesh. */
+  RunFingerprint
+  Fingerprint() const;
 
 private:
   struct ClusterModel;
   struct Candidate;
   struct CandidateBatch;
+
+  /** Everything but the header and the checksum (MoRvGomeaCheckpoint.cxx). */
+  void
+  WritePayload(std::ostream & out) const;
+  /** A whole checkpoint file's bytes: checked, then loaded. */
+  void
+  LoadBytes(const std::string & bytes);
 
   /** Draws each candidate's variables (its solution, element, cluster and
    *  seed are set) from its cluster's distribution for its element, in

@@ -6,6 +6,7 @@
 
 #include "itkMOREAImageIO.h"
 #include "itkMeshModel.h"
+#include "itkMeshRegistration.h"
 #include "itkObjectiveData.h"
 #include "itkPreprocessing.h"
 #include "morea/ComputeDevices.h"
@@ -227,6 +228,7 @@ AddBenchmarkCommand(CLI::App & app)
     const FoldConstraint constraint(model.topology, model.base.points, parameters.GetReal("morea_fold_volume_fraction"));
     const TetrahedronEvaluator evaluator(model.topology, constraint, model.elasticity, data);
     GomeaOptions               gomea = GomeaOptions::FromParameters(parameters);
+    gomea.fingerprint = itk::morea::RunFingerprintOf(preprocessed.problem, parameters); // as morea register's checkpoints
     if (options->drawAhead != "auto")
       gomea.drawAheadThreads = static_cast<std::size_t>(std::stoul(options->drawAhead));
     const auto                 initial = InitialPopulationOptions::FromParameters(parameters);

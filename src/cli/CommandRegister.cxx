@@ -91,6 +91,8 @@ RegisterOnce(const itk::morea::RegistrationProblem & input, const ParameterSet &
             << " tetrahedra (" << result.secondsModel << " s); optimisation " << result.secondsOptimisation
             << " s on the " << result.backend << " backend (" << result.threads << " threads); front of "
             << result.front.size() << "\n";
+  for (const auto & note : result.model.report.notes) // e.g. a surface constraint TetGen could not keep
+    std::cout << "note: mesh: " << note << "\n";
 
   const auto summary = WriteRegistrationOutputs(run, parameters, folder, nullptr, &times);
   for (const auto & selected : run.selected)

@@ -3,17 +3,92 @@
 #include "morea/Error.h"
 
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <system_error>
 #include <utility>
 
+#if defined(__unix__) || defined(__APPLE__)
+#  include <cerrno>
+#  include <fcntl.h>
+#  include <unistd.h>
+#  define MOREA_POSIX_FILES 1
+#else
+#  define MOREA_POSIX_FILES 0
+#endif
+
 namespace morea
 {
+#if MOREA_POSIX_FILES
+namespace
+{
+/** Writes and syncs `bytes` to a new file `path`. A rename alone is atomic
+ *  for readers but not across a power cut: without fsync the new name can
+ *  reach the disk before the data, leaving an empty or partial checkpoint. */
+void
+WriteSynced(const std::string & path, const std::string & bytes)
+{
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0)
+    throw Error("cannot write " + path + ": " + std::strerror(errno));
+  const char * p = bytes.data();
+  std::size_t  left = bytes.size();
+  while (left > 0)
+  {
+    const ssize_t n = ::write(fd, p, left);
+    if (n < 0 && errno == EINTR)
+      continue;
+    if (n <= 0)
+    {
+      const std::string why = std::strerror(n < 0 ? errno : EIO);
+      ::close(fd);
+      throw Error("writing " + path + " failed: " + why);
+    }
+    p += n;
+    left -= static_cast<std::size_t>(n);
+  }
+  if (::fsync(fd) != 0)
+  {
+    const std::string why = std::strerror(errno);
+    ::close(fd);
+    throw Error("writing " + path + " failed (fsync): " + why);
+  }
+  if (::close(fd) != 0)
+    throw Error("writing " + path + " failed: " + std::strerror(errno));
+}
+
+/** Syncs the folder, so that the rename into it is on the disk too. */
+void
+SyncFolderOf(const std::string & path)
+{
+  std::string folder = std::filesystem::path(path).parent_path().string();
+  if (folder.empty())
+    folder = ".";
+  const int fd = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0)
+    return; // some file systems do not open folders: the file itself is synced
+  ::fsync(fd);
+  ::close(fd);
+}
+} // namespace
+#endif
+
 void
 WriteFileAtomically(const std::string & path, const std::string & bytes)
 {
   const std::string temporary = path + ".partial";
+#if MOREA_POSIX_FILES
+  try
+  {
+    WriteSynced(temporary, bytes);
+  }
+  catch (const Error &)
+  {
+    std::remove(temporary.c_str());
+    throw;
+  }
+#else
   {
     std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
     if (!out)
@@ -26,6 +101,7 @@ WriteFileAtomically(const std::string & path, const std::string & bytes)
       throw Error("writing " + temporary + " failed");
     }
   }
+#endif
   std::error_code ec;
   std::filesystem::rename(temporary, path, ec);
   if (ec)
@@ -33,6 +109,9 @@ WriteFileAtomically(const std::string & path, const std::string & bytes)
     std::remove(temporary.c_str());
     throw Error("cannot rename " + temporary + " to " + path + ": " + ec.message());
   }
+#if MOREA_POSIX_FILES
+  SyncFolderOf(path);
+#endif
 }
 
 CheckpointWriter::~CheckpointWriter()

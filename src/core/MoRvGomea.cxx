@@ -49,6 +49,13 @@ MoRvGomea::MoRvGomea(const TetrahedralMesh & base, const MeshTopology & topology
     throw Error("optimiser: the population needs at least 2 solutions");
   if (options.numberOfClusters < 1 || options.archiveCapacity < 1)
     throw Error("optimiser: at least one cluster and an archive of at least 1 are needed");
+  if (options.numberOfClusters > options.populationSize)
+    // Clustering would have to make do with one cluster per solution (fewer
+    // than asked for, without a word): say so instead.
+    throw Error("optimiser: ea_num_clusters = " + std::to_string(options.numberOfClusters) +
+                " is more than the population (ea_population_size = " + std::to_string(options.populationSize) +
+                "); every cluster needs solutions of its own: use at most " + std::to_string(options.populationSize) +
+                " clusters, or a larger population (the paper: 10 clusters of 700 solutions)");
   if (!(options.selectionFraction > 0.0 && options.selectionFraction <= 1.0))
     throw Error("optimiser: the selection fraction must be in (0, 1]");
   if (parallel.elements.empty())

@@ -8,6 +8,7 @@
 #include "itkImageRegionIterator.h"
 #include "itkImageSeriesReader.h"
 
+#include "InputGeometryChecks.h"
 #include "ParallelGzip.h"
 
 #include <zlib.h>
@@ -104,32 +105,8 @@ CheckNotTruncated(const std::string & path, const ImageIOBase * io, const std::s
   }
   else if (endsWith(".mha"))
   {
-    std::ifstream in(path, std::ios::binary);
-    std::string   line;
-    long long     compressedSize = -1;
-    bool          compressed = false;
-    while (std::getline(in, line))
-    {
-      if (line.rfind("CompressedDataSize", 0) == 0)
-        compressedSize = std::atoll(line.substr(line.find('=') + 1).c_str());
-      if (line.rfind("CompressedData", 0) == 0 && line.find("True") != std::string::npos)
-        compressed = true;
-      if (line.rfind("ElementDataFile", 0) == 0)
-      {
-        if (line.find("LOCAL") == std::string::npos)
-          return; // data in another file: ITK checks that one
-        break;
-      }
-    }
-    const long long offset = static_cast<long long>(in.tellg());
-    const long long rest = static_cast<long long>(fs::file_size(path)) - offset;
-    if (compressed)
-    {
-      if (compressedSize > 0 && rest < compressedSize)
-        available = -1;
-      return CheckNotTruncated(path, available, needed, what);
-    }
-    available = rest;
+    // Raw and compressed: the data against DimSize (ITK pads a short compressed stream with zeros).
+    return CheckMetaImageDataSize(path, static_cast<unsigned long long>(needed), what);
   }
   CheckNotTruncated(path, available, needed, what);
 }
@@ -207,6 +184,10 @@ ReadDicomSeries(const std::string & directory)
   {
     Fail("cannot read DICOM series in '" + directory + "': " + e.GetDescription());
   }
+  // ITK takes the spacing of the first two slices and only warns when the
+  // others are spaced otherwise (a slice missing from the export, say).
+  if (const auto * slices = reader->GetMetaDataDictionaryArray())
+    CheckDicomSliceSpacing(*slices, directory);
   ImageType::Pointer image = reader->GetOutput();
   image->DisconnectPipeline();
   return image;
@@ -244,6 +225,7 @@ ValidateImage(const ImageBase<Dimension> * image, const std::string & what)
   {
     Fail(what + ": direction matrix is singular");
   }
+  CheckOrthonormalDirection(image->GetDirection(), what);
 }
 
 void

@@ -20,6 +20,74 @@ namespace itk
 {
 namespace morea
 {
+namespace
+{
+std::string
+Numbers(const double * values, unsigned int count)
+{
+  std::string text;
+  for (unsigned int i = 0; i < count; ++i)
+    text += (i ? " " : "") + ::morea::ExactText(values[i]);
+  return text;
+}
+
+/** An image's grid as text, and its voxels' hash, under `name`. */
+template <typename TImage>
+void
+AddImage(::morea::RunFingerprint & fingerprint, const std::string & name, const TImage * image)
+{
+  if (!image)
+  {
+    fingerprint.Add(name, "none");
+    return;
+  }
+  const auto   size = image->GetLargestPossibleRegion().GetSize();
+  const double sizes[3] = { static_cast<double>(size[0]), static_cast<double>(size[1]), static_cast<double>(size[2]) };
+  double       direction[9];
+  for (unsigned int r = 0; r < 3; ++r)
+    for (unsigned int c = 0; c < 3; ++c)
+      direction[3 * r + c] = image->GetDirection()[r][c];
+  fingerprint.Add(name + " grid", "size " + Numbers(sizes, 3) + ", spacing " +
+                                    Numbers(image->GetSpacing().GetDataPointer(), 3) + ", origin " +
+                                    Numbers(image->GetOrigin().GetDataPointer(), 3) + ", direction " +
+                                    Numbers(direction, 9));
+  fingerprint.AddHash(name + " voxels", image->GetBufferPointer(),
+                      image->GetPixelContainer()->Size() * sizeof(typename TImage::PixelType));
+}
+
+void
+AddPoints(::morea::RunFingerprint & fingerprint, const std::string & name, const PointListType & points)
+{
+  std::vector<double> coordinates;
+  for (const PointType & p : points)
+    coordinates.insert(coordinates.end(), { p[0], p[1], p[2] });
+  fingerprint.AddHash(name, coordinates.data(), coordinates.size() * sizeof(double));
+}
+} // namespace
+
+::morea::RunFingerprint
+RunFingerprintOf(const RegistrationProblem & problem, const ::morea::ParameterSet & parameters)
+{
+  ::morea::RunFingerprint fingerprint;
+  fingerprint.AddParameters(parameters);
+  AddImage(fingerprint, "fixed image", problem.fixedImage.GetPointer());
+  AddImage(fingerprint, "moving image", problem.movingImage.GetPointer());
+  AddImage(fingerprint, "fixed body mask", problem.fixedBodyMask.GetPointer());
+  AddImage(fingerprint, "moving body mask", problem.movingBodyMask.GetPointer());
+  std::string names;
+  for (const Structure & s : problem.structures)
+    names += (names.empty() ? "" : ", ") + s.name;
+  fingerprint.Add("structures", names);
+  for (const Structure & s : problem.structures)
+  {
+    AddImage(fingerprint, "structure " + s.name + " fixed mask", s.fixedMask.GetPointer());
+    AddImage(fingerprint, "structure " + s.name + " moving mask", s.movingMask.GetPointer());
+    AddPoints(fingerprint, "structure " + s.name + " fixed points", s.fixedPoints);
+    AddPoints(fingerprint, "structure " + s.name + " moving points", s.movingPoints);
+  }
+  return fingerprint;
+}
+
 MeshRegistrationResult
 RegisterMeshes(const RegistrationProblem & problem, const ::morea::ParameterSet & parameters,
                const MeshRegistrationOptions & options)
@@ -65,6 +133,11 @@ RegisterMeshes(const RegistrationProblem & problem, const ::morea::ParameterSet 
   ::morea::GomeaOptions gomea = ::morea::GomeaOptions::FromParameters(parameters);
   gomea.boundRefusals = ::morea::UsesRefusalBounds(options.refusalBounds, *backend);
   gomea.threads = options.threads; // the backend's pool: the two take turns on it
+  // What a checkpoint belongs to: the caller's entries, then the problem's.
+  gomea.fingerprint = options.fingerprint;
+  const ::morea::RunFingerprint ofProblem = RunFingerprintOf(problem, parameters);
+  for (const auto & [key, value] : ofProblem.Entries())
+    gomea.fingerprint.Add(key, value);
   ::morea::MoRvGomea optimiser(model.base, model.topology, model.parallel, constraint, *backend, gomea);
   if (options.resume && !options.checkpointPath.empty() && std::filesystem::exists(options.checkpointPath))
   {

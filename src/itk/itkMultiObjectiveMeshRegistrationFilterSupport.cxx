@@ -191,6 +191,7 @@ RunMultiObjectiveRegistration(const RegistrationProblem & problem, const ::morea
   PreprocessOptions preprocessing = PreprocessOptions::FromParameters(parameters);
   preprocessing.initialTransform = initialTransform;
   run.preprocessed = Preprocess(problem, preprocessing);
+  CheckGuidanceStructuresKept(run.preprocessed.report, parameters); // before the long part, not silently without it
   run.secondsPreprocessing = secondsSince(stage);
   report(PreprocessingProgressShare);
 

@@ -11,6 +11,7 @@
 #include "morea/ParameterSet.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <chrono>
 #include <cmath>
 #include <iterator>
@@ -472,6 +473,15 @@ Preprocess(const RegistrationProblem & input, const PreprocessOptions & options)
     if (emptyFixed || emptyMoving)
     {
       report.droppedStructures.push_back(s.name);
+      const std::string sides = emptyFixed && emptyMoving ? "fixed and moving masks have"
+                                : emptyFixed              ? "fixed mask has"
+                                                          : "moving mask has";
+      char margin[32];
+      std::snprintf(margin, sizeof margin, "%g mm", options.cropMargin);
+      report.droppedReasons.push_back(
+        "its " + sides + " no voxel inside " +
+        (report.cropStructure.empty() ? std::string("the fixed image's domain after the rigid pre-alignment")
+                                      : "the crop to '" + report.cropStructure + "' with a margin of " + margin));
       continue;
     }
     t.fixedPoints = t.fixedMask ? ExtractSurfacePoints(t.fixedMask) : s.fixedPoints;
@@ -490,6 +500,25 @@ Preprocess(const RegistrationProblem & input, const PreprocessOptions & options)
 
   report.secondsTotal = SecondsSince(start);
   return result;
+}
+
+void
+CheckGuidanceStructuresKept(const PreprocessReport & report, const ::morea::ParameterSet & parameters)
+{
+  const std::string &            selection = parameters.GetString("problem_guidance_selection");
+  const bool                     all = selection == "-1";
+  const std::vector<std::string> named = all ? std::vector<std::string>{} : ::morea::ParseNameList(selection);
+  for (std::size_t i = 0; i < report.droppedStructures.size(); ++i)
+  {
+    const std::string & name = report.droppedStructures[i];
+    if (all ? IsBodyName(name) : std::find(named.begin(), named.end(), name) == named.end())
+      continue;
+    const std::string why = i < report.droppedReasons.size() ? report.droppedReasons[i] : "it left the crop";
+    Fail("structure '" + name + "' vanished in preprocessing: " + why +
+         ", so the registration would run without it; crop to a region that holds it (preprocess_crop_structure, "
+         "preprocess_crop_margin), or leave it out" +
+         (all ? " (or name the structures to register in problem_guidance_selection)" : " of problem_guidance_selection"));
+  }
 }
 
 } // namespace morea

@@ -201,6 +201,52 @@ RegistrationProblem::LoadSide(const std::string & source, const ImageType * grid
 }
 
 void
+RegistrationProblem::CheckNoSideGivenTwice(const std::vector<StructureSource> & sources) const
+{
+  // One side of a structure takes one mask (an image, a label, an RTSTRUCT
+  // ROI) and one set of points (a point file, or the RTSTRUCT's contours): a
+  // mask and a point file add up, but a second mask or second points would
+  // silently replace the first (the same NAME given twice, say).
+  struct Given
+  {
+    std::string mask, points; // the sources that gave them; "" when none
+  };
+  std::map<std::pair<std::string, bool>, Given> given;
+  for (const Structure & s : structures)
+  {
+    given[{ s.name, true }] = { s.fixedMask ? "(loaded before)" : "", s.fixedPoints.empty() ? "" : "(loaded before)" };
+    given[{ s.name, false }] = { s.movingMask ? "(loaded before)" : "", s.movingPoints.empty() ? "" : "(loaded before)" };
+  }
+  for (const StructureSource & s : sources)
+  {
+    std::string path, selector;
+    try
+    {
+      SplitSource(s.source, path, selector);
+    }
+    catch (const ExceptionObject &)
+    {
+      continue; // a missing file: its load says so, naming the structure
+    }
+    const bool   pointFile = selector.empty() && IsPointFile(path);
+    const bool   givesMask = !pointFile, givesPoints = pointFile || IsStructureSet(path, selector);
+    Given &      g = given[{ s.name, s.fixedSide }];
+    const auto   quoted = [](const std::string & source) {
+      return source == "(loaded before)" ? std::string("one loaded before") : "'" + source + "'";
+    };
+    const std::string earlier = givesMask && !g.mask.empty() ? g.mask : givesPoints && !g.points.empty() ? g.points : "";
+    if (!earlier.empty())
+      Fail("structure '" + s.name + "' is given twice on the " + SideName(s.fixedSide) + " image: " + quoted(earlier) +
+           " and '" + s.source + "' both give its " + (givesMask && !g.mask.empty() ? "mask" : "points") +
+           "; give each structure once per image (a mask, and points from a point file if wanted), or rename one");
+    if (givesMask)
+      g.mask = s.source;
+    if (givesPoints)
+      g.points = s.source;
+  }
+}
+
+void
 RegistrationProblem::LoadStructures(const std::vector<StructureSource> & sources)
 {
   for (const StructureSource & s : sources)
@@ -212,6 +258,7 @@ RegistrationProblem::LoadStructures(const std::vector<StructureSource> & sources
   }
   if (sources.empty())
     return;
+  CheckNoSideGivenTwice(sources);
   // Label maps that several sources name are read once, on the first
   // thread that asks; the others wait for it.
   std::mutex                                                       labelMutex;

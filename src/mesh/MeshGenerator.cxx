@@ -1,5 +1,7 @@
 #include "morea/MeshGenerator.h"
 
+#include "ConstraintSurfaces.h"
+#include "morea/ChildProcess.h"
 #include "morea/Error.h"
 #include "morea/MeshPointPlacement.h"
 #include "morea/ParameterSet.h"
@@ -9,8 +11,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <functional>
 #include <numeric>
+#include <optional>
+#include <stdexcept>
 
 namespace morea
 {
@@ -34,19 +39,6 @@ InsideShrunk(const Vec3 & p, const MeshDomain & domain, double margin)
     if (p[a] < domain.lower[a] + margin || p[a] > domain.upper[a] - margin)
       return false;
   return true;
-}
-
-/** A copy of `mask` without the voxels closer than `inset` to the domain's faces. */
-Volume<std::uint8_t>
-ClearNearBoundary(const Volume<std::uint8_t> & mask, const MeshDomain & domain, double inset)
-{
-  Volume<std::uint8_t> cleared = mask;
-  for (std::size_t k = 0; k < mask.size[2]; ++k)
-    for (std::size_t j = 0; j < mask.size[1]; ++j)
-      for (std::size_t i = 0; i < mask.size[0]; ++i)
-        if (!InsideShrunk(mask.PointAt(i, j, k), domain, inset))
-          cleared(i, j, k) = 0;
-  return cleared;
 }
 
 /** Circumcentre of a tetrahedron; false when it is (nearly) flat. */
@@ -203,7 +195,7 @@ SliverShortfall(const TetrahedralizationResult & r)
  *  it lowers the total shortfall below the quality threshold. */
 void
 RemoveSlivers(PointSet & set, TetrahedralizationResult & tet,
-              const std::function<TetrahedralizationResult()> & tetrahedralize, RandomGenerator & random,
+              const std::function<TetrahedralizationResult(bool trial)> & tetrahedralize, RandomGenerator & random,
               const MeshDomain & domain, double margin, double contourJitter)
 {
   double currentBadness = SliverShortfall(tet);
@@ -249,11 +241,19 @@ RemoveSlivers(PointSet & set, TetrahedralizationResult & tet,
       set.points[i] = ProjectToDomain(q, set.pins[i], domain);
       moved[i] = true;
     }
-    TetrahedralizationResult trial = tetrahedralize();
-    const double             trialBadness = SliverShortfall(trial);
+    std::optional<TetrahedralizationResult> trial;
+    try
+    {
+      trial = tetrahedralize(true);
+    }
+    catch (const Error &)
+    {
+      // TetGen failed on the moved points with the surfaces: keep the last mesh.
+    }
+    const double trialBadness = trial ? SliverShortfall(*trial) : currentBadness;
     if (trialBadness < currentBadness)
     {
-      tet = std::move(trial);
+      tet = std::move(*trial);
       currentBadness = trialBadness;
     }
     else
@@ -261,6 +261,157 @@ RemoveSlivers(PointSet & set, TetrahedralizationResult & tet,
       set.points = saved;
     }
   }
+}
+
+/** What tetrahedralisation, refinement and sliver removal need of GenerateMesh. */
+struct PhaseInputs
+{
+  const MeshDomain &                     domain;
+  double                                 margin, pinTolerance, contourJitter;
+  std::size_t                            refinementBudget;
+  std::function<Vec3(RandomGenerator &)> drawInside;
+};
+
+/** A TetGen failure in a strict phase: not a morea::Error, so that sliver
+ *  removal does not take it for a trial that failed. */
+struct StrictPhaseFailure : std::runtime_error
+{
+  using std::runtime_error::runtime_error;
+};
+
+/** Tetrahedralises `set`, then spends the refinement budget and removes
+ *  slivers, re-tetrahedralising each time. Not strict: TetGen runs as
+ *  `constrained` says, and a failure drops surfaces (notes in `report`).
+ *  Strict: the first failure is thrown as StrictPhaseFailure. */
+TetrahedralizationResult
+RunPhase(PointSet & set, ConstrainedTetrahedralization & constrained, RandomGenerator & random,
+         const PhaseInputs & in, bool strict, MeshGenerationReport & report)
+{
+  // A failure falls back to fewer surfaces, then none, rather than fail the
+  // run; a trial (sliver removal) fails instead: it is simply not taken.
+  const auto tetrahedralize = [&](bool trial) {
+    if (!strict)
+      return constrained.Run(set.points, !trial, report.notes);
+    try
+    {
+      return constrained.Run(set.points, false, report.notes);
+    }
+    catch (const Error & e)
+    {
+      throw StrictPhaseFailure(e.what());
+    }
+  };
+  TetrahedralizationResult tet = tetrahedralize(false);
+
+  // Refinement: the rest of the budget goes, a few at a time, to the
+  // circumcentres of the worst tetrahedra (which destroys them, the new point
+  // lying inside their circumsphere).
+  for (std::size_t left = in.refinementBudget; left > 0;)
+  {
+    const std::size_t batch = std::max<std::size_t>(1, (in.refinementBudget + 3) / 4);
+    std::vector<Vec3> added = RefinementPoints(tet, set.points, std::min(batch, left), in.domain, in.margin);
+    if (added.empty())
+    {
+      added = BestCandidateRandomPoints(left, in.drawInside, set.points, random);
+      set.Add(added, PointOrigin::Random, -1, in.domain, in.pinTolerance);
+      report.randomPoints += left;
+      left = 0;
+    }
+    else
+    {
+      set.Add(added, PointOrigin::Refinement, -1, in.domain, in.pinTolerance);
+      report.refinementPoints += added.size();
+      left -= added.size();
+    }
+    tet = tetrahedralize(false);
+  }
+  RemoveSlivers(set, tet, tetrahedralize, random, in.domain, in.margin, in.contourJitter);
+  return tet;
+}
+
+// What a phase run in a child sends back: the point set and the mesh.
+template <typename T>
+void
+AppendVector(std::string & bytes, const std::vector<T> & v)
+{
+  const std::uint64_t n = v.size();
+  bytes.append(reinterpret_cast<const char *>(&n), sizeof n);
+  bytes.append(reinterpret_cast<const char *>(v.data()), v.size() * sizeof(T));
+}
+template <typename T>
+std::vector<T>
+ReadVector(const std::string & bytes, std::size_t & at)
+{
+  std::uint64_t n = 0;
+  if (bytes.size() - at < sizeof n)
+    throw Error("mesh generation: a child process sent a short answer");
+  std::memcpy(&n, bytes.data() + at, sizeof n);
+  at += sizeof n;
+  if ((bytes.size() - at) / sizeof(T) < n)
+    throw Error("mesh generation: a child process sent a short answer");
+  std::vector<T> v(n);
+  std::memcpy(v.data(), bytes.data() + at, n * sizeof(T));
+  at += n * sizeof(T);
+  return v;
+}
+
+/** RunPhase isolated from TetGen's crashes at the cost of one process:
+ *  the whole phase runs strictly in a child, TetGen in that child's own
+ *  process; only when it fails there (TetGen failed, or crashed on an error)
+ *  does it run again here with each TetGen run in a child of its own, where
+ *  surfaces can be dropped and sliver trials fail. Both give the same mesh
+ *  when nothing fails (the child works on a copy of the same state). A fork
+ *  costs about 13 ms per 300 MB of the process on the development machine,
+ *  and a mesh takes about 60 TetGen runs. */
+TetrahedralizationResult
+TetrahedralizeAndRefine(PointSet & set, ConstrainedTetrahedralization & constrained, RandomGenerator & random,
+                        const PhaseInputs & in, MeshGenerationReport & report, const TetrahedralizationOptions & options)
+{
+  if (!options.isolated || !ChildProcessesAvailable())
+    return RunPhase(set, constrained, random, in, false, report);
+  TetrahedralizationOptions inProcess = options;
+  inProcess.isolated = false;
+  inProcess.noRetryAfterFailure = true;
+  // The phase's some 60 runs take about 0.25 s for 600 points; three runs'
+  // time-outs leave room enough and stop a run that loops for ever sooner.
+  const double perRun = options.TimeoutFor(set.points.size());
+  const ChildResult child = RunInChildProcess(
+    [&]() {
+      ConstrainedTetrahedralization here = constrained.WithOptions(inProcess);
+      MeshGenerationReport          counts;
+      const TetrahedralizationResult tet = RunPhase(set, here, random, in, true, counts);
+      std::string                    bytes;
+      const std::uint64_t            numbers[3] = { counts.randomPoints, counts.refinementPoints, tet.steinerPoints };
+      bytes.append(reinterpret_cast<const char *>(numbers), sizeof numbers);
+      AppendVector(bytes, set.points);
+      AppendVector(bytes, set.origins);
+      AppendVector(bytes, set.structures);
+      AppendVector(bytes, set.pins);
+      AppendVector(bytes, tet.points);
+      AppendVector(bytes, tet.tetrahedra);
+      return bytes;
+    },
+    3.0 * perRun);
+  if (!child.ok)
+    return RunPhase(set, constrained, random, in, false, report);
+  std::uint64_t numbers[3];
+  if (child.bytes.size() < sizeof numbers)
+    throw Error("mesh generation: a child process sent a short answer");
+  std::memcpy(numbers, child.bytes.data(), sizeof numbers);
+  std::size_t at = sizeof numbers;
+  PointSet    result;
+  result.points = ReadVector<Vec3>(child.bytes, at);
+  result.origins = ReadVector<PointOrigin>(child.bytes, at);
+  result.structures = ReadVector<std::int32_t>(child.bytes, at);
+  result.pins = ReadVector<BoundaryPin>(child.bytes, at);
+  TetrahedralizationResult tet;
+  tet.points = ReadVector<Vec3>(child.bytes, at);
+  tet.tetrahedra = ReadVector<Tetrahedron>(child.bytes, at);
+  tet.steinerPoints = numbers[2];
+  set = std::move(result);
+  report.randomPoints += numbers[0];
+  report.refinementPoints += numbers[1];
+  return tet;
 }
 } // namespace
 
@@ -379,8 +530,9 @@ GenerateMesh(const MeshDomain & domain, const std::vector<MeshStructure> & struc
 
   // Surfaces first: their decimated vertices replace the structure's contour points.
   start = Clock::now();
-  std::vector<std::array<std::uint32_t, 3>> constraints;
-  std::vector<bool>                         hasSurface(structures.size(), false);
+  ConstrainedTetrahedralization constrained(options.tetrahedralization);
+  std::vector<TriangleSurface>  accepted; // the surfaces so far, which a later one may not meet
+  std::vector<bool>             hasSurface(structures.size(), false);
   for (std::size_t s = 0; s < structures.size(); ++s)
   {
     const MeshStructure & st = structures[s];
@@ -393,38 +545,21 @@ GenerateMesh(const MeshDomain & domain, const std::vector<MeshStructure> & struc
       report.notes.push_back("no mask for the surface of " + st.name + "; its contour points are used instead");
       continue;
     }
-    TriangleSurface surface = ExtractStructureSurface(*st.mask, quota[s]);
-    const auto      inside = [&](const TriangleSurface & surf) {
-      return std::all_of(surf.vertices.begin(), surf.vertices.end(),
-                         [&](const Vec3 & p) { return InsideShrunk(p, domain, margin); });
-    };
-    if (!surface.triangles.empty() && !inside(surface))
-    {
-      // A structure cut by the crop (lungs, say): close its surface a few
-      // voxels inside the domain so it stays a closed constraint.
-      const double inset = std::max(3.0 * *std::max_element(st.mask->spacing.begin(), st.mask->spacing.end()),
-                                    4.0 * margin);
-      surface = ExtractStructureSurface(ClearNearBoundary(*st.mask, domain, inset), quota[s]);
-      if (!surface.triangles.empty() && inside(surface))
-        report.notes.push_back("surface of " + st.name + " reaches the domain boundary; closed " +
-                               std::to_string(static_cast<int>(std::lround(inset * 10.0)) / 10) + "." +
-                               std::to_string(static_cast<int>(std::lround(inset * 10.0)) % 10) + " mm inside it");
-    }
-    if (surface.triangles.empty() || !inside(surface))
-    {
-      report.notes.push_back("surface of " + st.name +
-                             (surface.triangles.empty() ? " is empty" : " reaches the domain boundary") +
-                             "; its contour points are used instead");
+    std::optional<TriangleSurface> surface =
+      PrepareConstraintSurface(st.name, *st.mask, domain, quota[s], margin, accepted, report.notes);
+    if (!surface)
       continue;
-    }
     const auto offset = static_cast<std::uint32_t>(set.points.size());
-    for (const auto & t : surface.triangles)
-      constraints.push_back({ t[0] + offset, t[1] + offset, t[2] + offset });
-    set.Add(surface.vertices, PointOrigin::Surface, static_cast<std::int32_t>(s), domain, pinTolerance);
+    std::vector<std::array<std::uint32_t, 3>> triangles;
+    for (const auto & t : surface->triangles)
+      triangles.push_back({ t[0] + offset, t[1] + offset, t[2] + offset });
+    constrained.AddSurface(st.name, std::move(triangles));
+    set.Add(surface->vertices, PointOrigin::Surface, static_cast<std::int32_t>(s), domain, pinTolerance);
     hasSurface[s] = true;
-    report.surfacePoints += surface.vertices.size();
-    report.surfaceTriangles += surface.triangles.size();
-    report.pointsPerStructure.emplace_back(st.name, surface.vertices.size());
+    report.surfacePoints += surface->vertices.size();
+    report.surfaceTriangles += surface->triangles.size();
+    report.pointsPerStructure.emplace_back(st.name, surface->vertices.size());
+    accepted.push_back(std::move(*surface));
   }
   report.secondsSurfaces = SecondsSince(start);
 
@@ -479,47 +614,10 @@ GenerateMesh(const MeshDomain & domain, const std::vector<MeshStructure> & struc
   report.randomPoints = inner - refinementBudget;
   report.secondsPlacement += SecondsSince(start);
 
-  // Tetrahedralise; fall back to an unconstrained mesh rather than fail the run.
   start = Clock::now();
-  const auto tetrahedralize = [&]() {
-    try
-    {
-      return Tetrahedralize(set.points, constraints);
-    }
-    catch (const Error & e)
-    {
-      if (constraints.empty())
-        throw;
-      report.notes.push_back(std::string("surface constraints dropped: ") + e.what());
-      constraints.clear();
-      return Tetrahedralize(set.points);
-    }
-  };
-  TetrahedralizationResult tet = tetrahedralize();
-
-  // Refinement: the rest of the budget goes, a few at a time, to the
-  // circumcentres of the worst tetrahedra (which destroys them, the new point
-  // lying inside their circumsphere).
-  for (std::size_t left = refinementBudget; left > 0;)
-  {
-    const std::size_t batch = std::max<std::size_t>(1, (refinementBudget + 3) / 4);
-    std::vector<Vec3> added = RefinementPoints(tet, set.points, std::min(batch, left), domain, margin);
-    if (added.empty())
-    {
-      added = BestCandidateRandomPoints(left, drawInside, set.points, random);
-      set.Add(added, PointOrigin::Random, -1, domain, pinTolerance);
-      report.randomPoints += left;
-      left = 0;
-    }
-    else
-    {
-      set.Add(added, PointOrigin::Refinement, -1, domain, pinTolerance);
-      report.refinementPoints += added.size();
-      left -= added.size();
-    }
-    tet = tetrahedralize();
-  }
-  RemoveSlivers(set, tet, tetrahedralize, random, domain, margin, contourJitter);
+  PhaseInputs inputs{ domain, margin, pinTolerance, contourJitter, refinementBudget, drawInside };
+  TetrahedralizationResult tet =
+    TetrahedralizeAndRefine(set, constrained, random, inputs, report, options.tetrahedralization);
   report.secondsTetrahedralization = SecondsSince(start);
 
   TetrahedralMesh mesh;
@@ -529,7 +627,7 @@ GenerateMesh(const MeshDomain & domain, const std::vector<MeshStructure> & struc
   mesh.origins = std::move(set.origins);
   mesh.structures = std::move(set.structures);
   mesh.pins = std::move(set.pins);
-  mesh.constrainedFaces = std::move(constraints);
+  mesh.constrainedFaces = constrained.Triangles();
   for (std::size_t i = mesh.origins.size(); i < mesh.points.size(); ++i)
   {
     mesh.origins.push_back(PointOrigin::Steiner);

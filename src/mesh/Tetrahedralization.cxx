@@ -1,10 +1,12 @@
 #include "morea/Tetrahedralization.h"
 
+#include "morea/ChildProcess.h"
 #include "morea/Error.h"
 
 #include <tetgen.h>
 
 #include <cmath>
+#include <cstring>
 #include <string>
 
 namespace morea
@@ -78,65 +80,23 @@ Run(const char * switches, tetgenio & in, tetgenio & out, std::string & failure)
   }
   return true;
 }
-} // namespace
-
+/** One TetGen run with `switches`, and the result with positively oriented
+ *  tetrahedra; throws Error when TetGen reports an error. */
 TetrahedralizationResult
-Tetrahedralize(const std::vector<Vec3> & points, const std::vector<std::array<std::uint32_t, 3>> & constraintTriangles)
+RunTetGen(const char * switches, const std::vector<Vec3> & points,
+          const std::vector<std::array<std::uint32_t, 3>> & constraintTriangles)
 {
-  if (points.size() < 4)
-  {
-    throw Error("tetrahedralisation needs at least 4 points, got " + std::to_string(points.size()));
-  }
-  for (const auto & t : constraintTriangles)
-  {
-    for (std::uint32_t v : t)
-    {
-      if (v >= points.size())
-      {
-        throw Error("constraint triangle refers to point " + std::to_string(v) + " of " +
-                    std::to_string(points.size()));
-      }
-    }
-  }
-
-  // Q quiet, z zero-based. With constraints: p reads them as a piecewise
-  // linear complex, c keeps the whole convex hull (the domain box) instead of
-  // carving the outside of the surfaces away, Y first forbids Steiner points
-  // on the constraints so the surfaces' vertices stay the mesh points.
-  tetgenio    out;
+  tetgenio    in, out;
   std::string failure;
-  bool        ok = false;
-  if (constraintTriangles.empty())
-  {
-    tetgenio in;
-    FillInput(in, points, constraintTriangles);
-    ok = Run("Qz", in, out, failure);
-  }
-  else
-  {
-    for (const char * switches : { "pcYQz", "pcQz" })
-    {
-      tetgenio in;
-      FillInput(in, points, constraintTriangles);
-      out.deinitialize();
-      out.initialize();
-      if ((ok = Run(switches, in, out, failure)))
-      {
-        break;
-      }
-    }
-  }
-  if (!ok)
-  {
-    throw Error("TetGen could not tetrahedralise the mesh points: " + failure);
-  }
+  FillInput(in, points, constraintTriangles);
+  if (!Run(switches, in, out, failure))
+    throw Error(failure);
   if (out.numberofpoints < static_cast<int>(points.size()))
   {
     // TetGen drops duplicate points; the caller's indices would no longer match.
     throw Error("TetGen merged " + std::to_string(points.size() - static_cast<std::size_t>(out.numberofpoints)) +
                 " duplicate mesh points");
   }
-
   TetrahedralizationResult result;
   result.points.resize(static_cast<std::size_t>(out.numberofpoints));
   for (std::size_t i = 0; i < result.points.size(); ++i)
@@ -162,5 +122,96 @@ Tetrahedralize(const std::vector<Vec3> & points, const std::vector<std::array<st
     result.tetrahedra.push_back(tet);
   }
   return result;
+}
+
+// The result through the child's pipe: counts, then the arrays as they lie in memory.
+std::string
+Serialise(const TetrahedralizationResult & r)
+{
+  const std::uint64_t header[3] = { r.points.size(), r.tetrahedra.size(), r.steinerPoints };
+  std::string         bytes(reinterpret_cast<const char *>(header), sizeof header);
+  bytes.append(reinterpret_cast<const char *>(r.points.data()), r.points.size() * sizeof(Vec3));
+  bytes.append(reinterpret_cast<const char *>(r.tetrahedra.data()), r.tetrahedra.size() * sizeof(Tetrahedron));
+  return bytes;
+}
+
+TetrahedralizationResult
+Deserialise(const std::string & bytes)
+{
+  std::uint64_t header[3];
+  if (bytes.size() < sizeof header)
+    throw Error("TetGen's child process sent a short answer");
+  std::memcpy(header, bytes.data(), sizeof header);
+  if (bytes.size() != sizeof header + header[0] * sizeof(Vec3) + header[1] * sizeof(Tetrahedron))
+    throw Error("TetGen's child process sent an answer of the wrong size");
+  TetrahedralizationResult r;
+  r.points.resize(header[0]);
+  r.tetrahedra.resize(header[1]);
+  r.steinerPoints = header[2];
+  std::memcpy(r.points.data(), bytes.data() + sizeof header, r.points.size() * sizeof(Vec3));
+  std::memcpy(r.tetrahedra.data(), bytes.data() + sizeof header + r.points.size() * sizeof(Vec3),
+              r.tetrahedra.size() * sizeof(Tetrahedron));
+  return r;
+}
+} // namespace
+
+TetrahedralizationResult
+Tetrahedralize(const std::vector<Vec3> & points, const std::vector<std::array<std::uint32_t, 3>> & constraintTriangles,
+               const TetrahedralizationOptions & options)
+{
+  if (points.size() < 4)
+  {
+    throw Error("tetrahedralisation needs at least 4 points, got " + std::to_string(points.size()));
+  }
+  for (const auto & t : constraintTriangles)
+  {
+    for (std::uint32_t v : t)
+    {
+      if (v >= points.size())
+      {
+        throw Error("constraint triangle refers to point " + std::to_string(v) + " of " +
+                    std::to_string(points.size()));
+      }
+    }
+  }
+
+  // Q quiet, z zero-based. With constraints: p reads them as a piecewise
+  // linear complex, c keeps the whole convex hull (the domain box) instead of
+  // carving the outside of the surfaces away, Y first forbids Steiner points
+  // on the constraints so the surfaces' vertices stay the mesh points.
+  // Each attempt runs in a child process when asked to (ChildProcess.h: an
+  // error inside TetGen 1.5 corrupts its heap), so a crash is one more failure.
+  const double timeout = options.TimeoutFor(points.size());
+  std::string failure;
+  for (const char * switches : constraintTriangles.empty() ? std::vector<const char *>{ "Qz" }
+                                                           : std::vector<const char *>{ "pcYQz", "pcQz" })
+  {
+    if (!options.isolated)
+    {
+      try
+      {
+        return RunTetGen(switches, points, constraintTriangles);
+      }
+      catch (const Error & e)
+      {
+        if (options.noRetryAfterFailure)
+          throw;
+        failure = e.what();
+        continue;
+      }
+    }
+    const ChildResult child = RunInChildProcess(
+      [&]() { return Serialise(RunTetGen(switches, points, constraintTriangles)); }, timeout);
+    if (child.ok)
+      return Deserialise(child.bytes);
+    failure = child.crashed ? "TetGen " + child.failure +
+                                (constraintTriangles.empty()
+                                   ? std::string()
+                                   : "; TetGen 1.5 crashes on the errors it finds, such as constraint "
+                                     "triangles that intersect or nearly touch")
+              : child.timedOut ? "TetGen " + child.failure
+                               : child.failure;
+  }
+  throw Error("TetGen could not tetrahedralise the mesh points: " + failure);
 }
 } // namespace morea

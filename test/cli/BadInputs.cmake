@@ -94,6 +94,9 @@ def nifti(dims, spacing, data):
     return bytes(h) + bytes(4) + data
 compressed = gzip.compress(nifti(grid[0], grid[1], floats(moving)))
 write("truncated.nii.gz", compressed[: len(compressed) // 2])
+# A small cube in the grid's corner, far from the blob (outside a crop to it).
+write("corner.mha", header(grid[0], "MET_UCHAR", grid[1]) +
+      uchars(int(i < 3 and j < 3 and k < 3) for k in range(N) for j in range(N) for i in range(N)))
 # A zero spacing, with a complete data file beside the header.
 write("zero_spacing.mhd", header((4, 4, 4), "MET_FLOAT", (0.0, 1.0, 1.0), datafile="zero_spacing.raw"))
 write("zero_spacing.raw", floats([1.0] * 64))
@@ -398,6 +401,24 @@ expect_failure("benchmark: start from a damaged checkpoint" OUTPUTS "${WORK}/ben
   ARGS benchmark --fixed "${fixed}" --moving "${moving}" ${blob} --set ea_population_size=8 --set ea_num_clusters=2
        --set morea_mesh_num_points=40 --set preprocess_rigid_structure=none --backends cpu --probe 0
        --from-checkpoint "${WORK}/benchmark-bad-checkpoint.bin" -o "${WORK}/benchmark-out.json")
+# The same structure twice on one image: the second would replace the first.
+expect_failure("register: one structure given twice" OUTPUTS ${o}
+  FRAGMENTS "structure 'blob' is given twice on the fixed image" "blob_moving\\.mha' both give its mask"
+  ARGS register --fixed "${fixed}" --moving "${moving}" ${blob} --fixed-structure "blob=${in}/blob_moving.mha"
+       --set ea_population_size=8 --set ea_num_clusters=2 --set ea_num_generations=1 --set morea_mesh_num_points=40
+       --set preprocess_rigid_structure=none --backend cpu -o "${o}")
+# A guidance structure outside the crop: refused before the optimisation, with the reason.
+expect_failure("register: a structure that vanishes in preprocessing" OUTPUTS ${o}
+  FRAGMENTS "structure 'corner' vanished in preprocessing" "no voxel inside the crop to 'blob'" "preprocess_crop_margin"
+  ARGS register --fixed "${fixed}" --moving "${moving}" ${blob} --fixed-structure "corner=${in}/corner.mha"
+       --moving-structure "corner=${in}/corner.mha" --set preprocess_crop_structure=blob --set preprocess_crop_margin=2
+       --set ea_population_size=8 --set ea_num_clusters=2 --set ea_num_generations=1 --set morea_mesh_num_points=40
+       --set preprocess_rigid_structure=none --backend cpu -o "${o}")
+expect_failure("register: more clusters than solutions" OUTPUTS ${o}
+  FRAGMENTS "ea_num_clusters = 9 is more than the population \\(ea_population_size = 8\\)"
+  ARGS register --fixed "${fixed}" --moving "${moving}" ${blob} --set ea_population_size=8 --set ea_num_clusters=9
+       --set ea_num_generations=1 --set morea_mesh_num_points=40 --set preprocess_rigid_structure=none --backend cpu
+       -o "${o}")
 file(WRITE "${WORK}/initial-2d.tfm" "#Insight Transform File V1.0\n#Transform 0\nTransform: AffineTransform_double_2_2\n"
   "Parameters: 1 0 0 1 0 0\nFixedParameters: 0 0\n")
 expect_failure("register: a 2-D initial transform" OUTPUTS ${o} FRAGMENTS "initial moving transform" "3-D transform"

@@ -1,0 +1,118 @@
+// Resuming RegisterMeshes from its checkpoint: allowed with what it was
+// written with (also for more generations), refused with other objective or
+// preprocessing parameters or other images, naming the first key that differs.
+#include "itkMeshRegistration.h"
+#include "itkPhantomImages.h"
+#include "itkPreprocessing.h"
+#include "morea/Error.h"
+#include "morea/ParameterSet.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+namespace
+{
+using namespace itk::morea;
+
+struct SmallRun
+{
+  RegistrationProblem   problem;
+  ::morea::ParameterSet parameters;
+  std::string           checkpoint;
+
+  SmallRun()
+  {
+    ::morea::PhantomOptions phantom;
+    phantom.spacing = 4.0;
+    PreprocessOptions pre;
+    pre.isotropicSpacing = 4.0;
+    pre.rigidStructure = "none";
+    problem = Preprocess(MakePhantomProblem(::morea::PelvisPhantom(phantom).Generate()), pre).problem;
+    for (const auto & [key, value] : std::vector<std::pair<std::string, std::string>>{
+           { "ea_population_size", "8" },
+           { "ea_num_clusters", "2" },
+           { "ea_archive_size", "20" },
+           { "ea_num_generations", "2" },
+           { "morea_mesh_num_points", "40" },
+           { "morea_sampling_rate", "0.3" },
+           { "seed", "4" } })
+      parameters.SetFromString(key, value);
+    std::filesystem::create_directories(MOREA_TEST_OUTPUT_DIR);
+    checkpoint = std::string(MOREA_TEST_OUTPUT_DIR) + "/resume_checkpoint.bin";
+    std::filesystem::remove(checkpoint);
+  }
+  ~SmallRun() { std::filesystem::remove(checkpoint); }
+
+  MeshRegistrationResult
+  Run(const ::morea::ParameterSet & p, const RegistrationProblem & on) const
+  {
+    MeshRegistrationOptions options;
+    options.checkpointPath = checkpoint;
+    options.checkpointInterval = 1;
+    options.resume = true;
+    options.backend = ::morea::BackendChoice::Cpu;
+    options.threads = 2;
+    return RegisterMeshes(on, p, options);
+  }
+  /** The message of the resume's refusal; "" when it resumed. */
+  std::string
+  Refusal(const ::morea::ParameterSet & p, const RegistrationProblem & on) const
+  {
+    try
+    {
+      Run(p, on);
+    }
+    catch (const std::exception & e)
+    {
+      return e.what();
+    }
+    return {};
+  }
+};
+
+TEST(CheckpointResume, OtherParametersOrImagesAreRefusedNamingTheKey)
+{
+  SmallRun run;
+  EXPECT_EQ(run.Run(run.parameters, run.problem).resumedAtGeneration, 0u);
+  ASSERT_TRUE(std::filesystem::exists(run.checkpoint));
+  const std::string prefix = "checkpoint " + run.checkpoint + ": it was written by a run with other inputs or parameters (";
+
+  ::morea::ParameterSet rate = run.parameters;
+  rate.SetFromString("morea_sampling_rate", "0.5");
+  EXPECT_EQ(run.Refusal(rate, run.problem),
+            prefix + "morea_sampling_rate: 0.3 in the checkpoint, 0.5 in this run); resume with those it was written "
+                     "with, or start afresh");
+
+  ::morea::ParameterSet factors = run.parameters;
+  factors.SetFromString("morea_elasticity_factors", "bones=10, bladder=2");
+  EXPECT_EQ(run.Refusal(factors, run.problem),
+            prefix + "morea_elasticity_factors: \"bones=10, bladder=0.5\" in the checkpoint, \"bones=10, bladder=2\" "
+                     "in this run); resume with those it was written with, or start afresh");
+
+  // Other voxels of the same size: the image's hash differs.
+  RegistrationProblem other = run.problem;
+  other.movingImage = ImageType::New();
+  other.movingImage->CopyInformation(run.problem.movingImage);
+  other.movingImage->SetRegions(run.problem.movingImage->GetLargestPossibleRegion());
+  other.movingImage->Allocate();
+  const auto n = run.problem.movingImage->GetPixelContainer()->Size();
+  std::copy_n(run.problem.movingImage->GetBufferPointer(), n, other.movingImage->GetBufferPointer());
+  other.movingImage->GetBufferPointer()[n / 2] += 0.25f;
+  const std::string image = run.Refusal(run.parameters, other);
+  EXPECT_EQ(image.rfind(prefix + "moving image voxels: xxh64:", 0), 0u) << image;
+
+  // A run that ends before the checkpoint's generation.
+  ::morea::ParameterSet shorter = run.parameters;
+  shorter.SetFromString("ea_num_generations", "1");
+  EXPECT_EQ(run.Refusal(shorter, run.problem),
+            "checkpoint " + run.checkpoint + ": it holds generation 2, beyond this run's 1 (ea_num_generations)");
+
+  // The same, for longer: resumes.
+  ::morea::ParameterSet longer = run.parameters;
+  longer.SetFromString("ea_num_generations", "3");
+  const auto resumed = run.Run(longer, run.problem);
+  EXPECT_EQ(resumed.resumedAtGeneration, 2u);
+  EXPECT_EQ(resumed.history.size(), 4u);
+}
+} // namespace
