@@ -1,4 +1,5 @@
 #include "InputGeometryChecks.h"
+#include "itkMOREAFail.h"
 
 #include "itkMacro.h"
 #include "itkMetaDataObject.h"
@@ -20,12 +21,6 @@ namespace morea
 {
 namespace
 {
-[[noreturn]] void
-Fail(const std::string & message)
-{
-  itkGenericExceptionMacro(<< message);
-}
-
 std::string
 Number(double value, int digits = 4)
 {

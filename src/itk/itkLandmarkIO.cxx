@@ -1,4 +1,5 @@
 #include "itkLandmarkIO.h"
+#include "itkMOREAFail.h"
 
 #include "itkMOREAImageIO.h"
 
@@ -16,12 +17,6 @@ namespace morea
 {
 namespace
 {
-[[noreturn]] void
-Fail(const std::string & message)
-{
-  itkGenericExceptionMacro(<< message);
-}
-
 std::string
 Lower(std::string s)
 {

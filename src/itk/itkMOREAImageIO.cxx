@@ -1,4 +1,5 @@
 #include "itkMOREAImageIO.h"
+#include "itkMOREAFail.h"
 
 #include "itkGDCMImageIO.h"
 #include "itkGDCMSeriesFileNames.h"
@@ -29,12 +30,6 @@ namespace morea
 {
 namespace
 {
-[[noreturn]] void
-Fail(const std::string & message)
-{
-  itkGenericExceptionMacro(<< message);
-}
-
 void
 CheckNotTruncated(const std::string & path, long long available, long long needed, const std::string & what)
 {

@@ -1,4 +1,5 @@
 #include "itkPreprocessing.h"
+#include "itkMOREAFail.h"
 
 #include "itkImageRegionConstIterator.h"
 #include "itkImageRegionConstIteratorWithIndex.h"
@@ -23,12 +24,6 @@ namespace morea
 {
 namespace
 {
-[[noreturn]] void
-Fail(const std::string & message)
-{
-  itkGenericExceptionMacro(<< message);
-}
-
 
 /** Index box of the non-zero voxels; false when there are none. Rows are
  *  scanned in the buffer from both ends: an iterator that tracks every

@@ -4,6 +4,7 @@
  *  DCMTK stays inside this file: the public header only exposes ITK types.
  *=========================================================================*/
 #include "itkRTStructureSetIO.h"
+#include "itkMOREAFail.h"
 
 #include "itkImageRegionIterator.h"
 #include "itkMacro.h"
@@ -30,12 +31,6 @@ namespace morea
 {
 namespace
 {
-[[noreturn]] void
-Fail(const std::string & message)
-{
-  itkGenericExceptionMacro(<< message);
-}
-
 std::string
 Trimmed(const OFString & value)
 {

@@ -5,6 +5,7 @@
  *  grid of their inputs; physical distances use spacing and direction.
  *=========================================================================*/
 #include "itkRegistrationMetrics.h"
+#include "itkMOREAFail.h"
 
 #include "itkMOREAImageIO.h"
 #include "itkSurfaceElements.h"
@@ -34,12 +35,6 @@ namespace morea
 {
 namespace
 {
-[[noreturn]] void
-Fail(const std::string & message)
-{
-  itkGenericExceptionMacro(<< message);
-}
-
 using IndexArray = std::array<SizeValueType, Dimension>;
 using FieldInterpolatorType = VectorLinearInterpolateImageFunction<DisplacementFieldType, double>;
 

@@ -1,4 +1,5 @@
 #include "itkRegistrationProblem.h"
+#include "itkMOREAFail.h"
 
 #include "itkObjectFactoryBase.h"
 #include "itkImageRegionConstIterator.h"
@@ -25,12 +26,6 @@ namespace morea
 {
 namespace
 {
-[[noreturn]] void
-Fail(const std::string & message)
-{
-  itkGenericExceptionMacro(<< message);
-}
-
 bool
 IsDicomFile(const std::string & path)
 {

@@ -1,4 +1,5 @@
 #include "itkRigidPreAlignment.h"
+#include "itkMOREAFail.h"
 
 #include "itkImageRegionConstIteratorWithIndex.h"
 #include "itkImageRegionConstIterator.h"
@@ -26,12 +27,6 @@ namespace morea
 {
 namespace
 {
-[[noreturn]] void
-Fail(const std::string & message)
-{
-  itkGenericExceptionMacro(<< message);
-}
-
 PointType
 Centroid(const MaskType * mask)
 {
