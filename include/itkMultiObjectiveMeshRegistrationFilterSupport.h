@@ -115,6 +115,11 @@ RunMultiObjectiveRegistration(const RegistrationProblem & problem, const ::morea
                               const std::function<void(double)> & progress,
                               const PreAlignmentTransformType * initialTransform = nullptr);
 
+/** An ITK exception's description without the "ITK ERROR: Class(0x...): "
+ *  prefix that itkExceptionMacro adds: the message as a user should read it. */
+std::string
+UserMessage(const std::string & description);
+
 /** Prints the explicitly set parameters and the main run keys, one per line. */
 void
 PrintParameters(std::ostream & os, const ::morea::ParameterSet & parameters, Indent indent);

@@ -102,13 +102,7 @@ UpdateRegistrationFilter(RegistrationFilterType & filter)
   }
   catch (const itk::ExceptionObject & e)
   {
-    // The message without ITK's "ITK ERROR: Class(0x...): " prefix.
-    std::string       text = e.GetDescription();
-    const std::string prefix = std::string("ITK ERROR: ") + filter.GetNameOfClass() + "(";
-    if (text.rfind(prefix, 0) == 0)
-      if (const auto end = text.find("): "); end != std::string::npos)
-        text = text.substr(end + 3);
-    throw Error(text);
+    throw Error(itk::morea::UserMessage(e.GetDescription()));
   }
 }
 } // namespace morea::cli

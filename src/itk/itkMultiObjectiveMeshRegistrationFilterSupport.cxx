@@ -232,6 +232,15 @@ RunMultiObjectiveRegistration(const RegistrationProblem & problem, const ::morea
   return run;
 }
 
+std::string
+UserMessage(const std::string & description)
+{
+  if (description.rfind("ITK ERROR: ", 0) == 0)
+    if (const auto end = description.find("): "); end != std::string::npos)
+      return description.substr(end + 3);
+  return description;
+}
+
 void
 PrintParameters(std::ostream & os, const ::morea::ParameterSet & parameters, Indent indent)
 {

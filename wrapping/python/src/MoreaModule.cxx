@@ -279,7 +279,7 @@ public:
     if (raised)
       throw *raised;
     if (!failure.empty())
-      throw std::runtime_error(StripItkPrefix(failure));
+      throw std::runtime_error(itk::morea::UserMessage(failure));
   }
 
   /** The front's ids and objective values (magnitude, intensity, guidance), by ascending guidance. */
@@ -375,16 +375,6 @@ public:
   }
 
 private:
-  static std::string
-  StripItkPrefix(std::string text)
-  {
-    // "ITK ERROR: Class(0x...): message" -> "message"
-    if (text.rfind("ITK ERROR: ", 0) == 0)
-      if (const auto end = text.find("): "); end != std::string::npos)
-        text = text.substr(end + 3);
-    return text;
-  }
-
   template <typename F>
   static void
   Call(F && f)
@@ -395,7 +385,7 @@ private:
     }
     catch (const itk::ExceptionObject & e)
     {
-      throw py::value_error(StripItkPrefix(e.GetDescription()));
+      throw py::value_error(itk::morea::UserMessage(e.GetDescription()));
     }
   }
 
