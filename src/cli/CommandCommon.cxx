@@ -188,30 +188,6 @@ WriteProblemFolder(const itk::morea::RegistrationProblem & problem, const std::s
   }
 }
 
-nlohmann::json
-ToJson(const itk::morea::EvaluationScores & scores)
-{
-  nlohmann::json j;
-  j["border_margin_mm"] = scores.borderMargin;
-  for (const auto & s : scores.structures)
-    j["structures"][s.name] = { { "dice", s.dice },
-                                { "hausdorff_mm", s.hausdorff },
-                                { "hausdorff95_mm", s.hausdorff95 },
-                                { "mean_surface_distance_mm", s.meanSurfaceDistance } };
-  if (scores.hasLandmarks)
-    j["landmarks"] = { { "count", scores.landmarks.errors.size() },
-                       { "outside_domain", scores.landmarksOutside },
-                       { "tre_mean_mm", scores.landmarks.mean },
-                       { "tre_sd_mm", scores.landmarks.standardDeviation },
-                       { "tre_max_mm", scores.landmarks.maximum },
-                       { "tre_mm", scores.landmarks.errors } };
-  j["jacobian_nonpositive_fraction"] = scores.nonPositiveJacobianFraction;
-  if (scores.hasInverse)
-    j["inverse_consistency"] = { { "mean_mm", scores.inverseConsistency.mean },
-                                 { "max_mm", scores.inverseConsistency.maximum } };
-  return j;
-}
-
 void
 PrintScores(std::ostream & out, const itk::morea::EvaluationScores & scores, const std::string & title)
 {

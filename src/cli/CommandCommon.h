@@ -63,17 +63,9 @@ SplitAssignment(const std::string & text, const std::string & what);
 void
 WriteJson(const nlohmann::json & json, const std::string & path);
 
-nlohmann::json
-ToJson(const itk::morea::EvaluationScores & scores);
 /** A plain-text table of the scores. */
 void
 PrintScores(std::ostream & out, const itk::morea::EvaluationScores & scores, const std::string & title);
-
-/** Renders PREFIX_{axial,coronal,sagittal}.png: fixed contours (green) and moving
- *  contours warped by `field` (magenta; identity when null) on the fixed image. */
-void
-RenderComparison(const itk::morea::RegistrationProblem & problem, const itk::morea::DisplacementFieldType * field,
-                 const std::string & focusStructure, const std::string & prefix);
 
 void
 AddPhantomCommand(CLI::App & app);

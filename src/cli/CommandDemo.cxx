@@ -2,7 +2,7 @@
 // preprocesses it, and scores the rigid baseline and the known true
 // deformation with the evaluation pipeline.
 #include "CommandCommon.h"
-#include "RegistrationOutputs.h"
+#include "ProgressPrinter.h"
 
 #include "FilterRun.h"
 
@@ -10,7 +10,9 @@
 #include "itkMOREAImageIO.h"
 #include "itkPhantomImages.h"
 #include "itkPreprocessing.h"
+#include "itkRegistrationOutputs.h"
 #include "morea/ComputeDevices.h"
+#include "morea/OutputFolderLock.h"
 
 #include <chrono>
 #include <filesystem>
@@ -98,6 +100,7 @@ AddDemoCommand(CLI::App & app)
     phantomOptions.spacing = options->spacing;
     const PelvisPhantom phantom(phantomOptions);
     const fs::path      root(options->output);
+    const OutputFolderLock ownership(root.string());
     WritePhantomCase(phantom.Generate(), (root / "phantom").string());
     std::cout << "1. phantom written to " << (root / "phantom").string() << "\n";
 
@@ -130,7 +133,7 @@ AddDemoCommand(CLI::App & app)
     const auto   truth = EvaluateRegistration(result.problem, forward, inverse, margin);
     WriteDisplacementField(forward, (root / "preprocessed_true_fixed_to_moving.nii.gz").string());
     WriteDisplacementField(inverse, (root / "preprocessed_true_moving_to_fixed.nii.gz").string());
-    const auto summary = WriteRegistrationOutputs(run, parameters, (root / "registration").string(), forward);
+    const auto summary = itk::morea::WriteRegistrationOutputs(run, parameters, (root / "registration").string(), forward);
 
     std::cout << "4. evaluation\n";
     PrintScores(std::cout, baseline, "   baseline after rigid pre-alignment");
@@ -145,9 +148,9 @@ AddDemoCommand(CLI::App & app)
                   << v["hausdorff95_mm"].get<double>() << " mm\n";
     }
     PrintScores(std::cout, truth, "   true deformation (upper bound of what a registration can reach)");
-    RenderComparison(result.problem, nullptr, r.cropStructure, (root / "render_baseline").string());
-    RenderComparison(result.problem, forward, r.cropStructure, (root / "render_truth").string());
-    WriteJson({ { "baseline", ToJson(baseline) }, { "truth", ToJson(truth) }, { "morea", summary } },
+    itk::morea::RenderComparison(result.problem, nullptr, r.cropStructure, (root / "render_baseline").string());
+    itk::morea::RenderComparison(result.problem, forward, r.cropStructure, (root / "render_truth").string());
+    WriteJson({ { "baseline", itk::morea::ScoresToJson(baseline) }, { "truth", itk::morea::ScoresToJson(truth) }, { "morea", summary } },
               (root / "scores.json").string());
     std::cout << "5. scores.json, registration/ and render_*.png written to " << root.string() << " ("
               << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() << " s)\n";

@@ -1,9 +1,8 @@
 // `morea evaluate`: scores a registration (or the identity baseline) on a problem.
 #include "CommandCommon.h"
 
-#include "itkContourOverlayRenderer.h"
+#include "itkRegistrationOutputs.h"
 #include "itkMOREAImageIO.h"
-#include "itkMinimumMaximumImageCalculator.h"
 
 #include <algorithm>
 #include <iostream>
@@ -11,50 +10,6 @@
 
 namespace morea::cli
 {
-void
-RenderComparison(const itk::morea::RegistrationProblem & problem, const itk::morea::DisplacementFieldType * field,
-                 const std::string & focusStructure, const std::string & prefix)
-{
-  using namespace itk::morea;
-  DisplacementFieldType::Pointer identity;
-  if (field == nullptr)
-  {
-    identity = MakeIdentityField(problem.fixedImage);
-    field = identity;
-  }
-  // Fixed contours in green, warped moving contours in magenta; the focus structure first
-  // so that the slice goes through it.
-  std::vector<const Structure *> order;
-  for (const auto & s : problem.structures)
-    if (s.fixedMask && s.movingMask && s.name != "body")
-      order.push_back(&s);
-  std::stable_partition(order.begin(), order.end(), [&](const Structure * s) { return s->name == focusStructure; });
-  std::vector<MaskType::Pointer> warped;
-  std::vector<ContourLayer>      layers;
-  for (const Structure * s : order)
-  {
-    warped.push_back(WarpMask(s->movingMask, field));
-    layers.push_back({ s->fixedMask.GetPointer(), { { 0, 220, 0 } }, s->name + " (fixed)" });
-    layers.push_back({ warped.back().GetPointer(), { { 255, 0, 255 } }, s->name + " (moving, warped)" });
-  }
-  auto range = itk::MinimumMaximumImageCalculator<ImageType>::New();
-  range->SetImage(problem.fixedImage);
-  range->Compute();
-  SliceRenderOptions options;
-  if (range->GetMaximum() <= 1.0f && range->GetMinimum() >= 0.0f)
-  {
-    options.windowMin = 0.0f; // preprocessed images are already windowed to [0,1]
-    options.windowMax = 1.0f;
-  }
-  options.pixelsPerMm = 3.0 / problem.fixedImage->GetSpacing()[0];
-  for (const auto & [axis, name] : { std::pair{ SliceAxis::Axial, "axial" }, { SliceAxis::Coronal, "coronal" },
-                                     { SliceAxis::Sagittal, "sagittal" } })
-  {
-    options.axis = axis;
-    RenderContourOverlay(problem.fixedImage, layers, options, prefix + "_" + name + ".png");
-  }
-}
-
 void
 AddEvaluateCommand(CLI::App & app)
 {
@@ -95,9 +50,9 @@ AddEvaluateCommand(CLI::App & app)
     const auto scores = EvaluateRegistration(problem, forward, inverse, margin);
     PrintScores(std::cout, scores, forward ? "scores of " + options->field : "baseline scores (identity)");
     if (!options->output.empty())
-      WriteJson(ToJson(scores), options->output);
+      WriteJson(itk::morea::ScoresToJson(scores), options->output);
     if (!options->renderPrefix.empty())
-      RenderComparison(problem, forward, options->focus, options->renderPrefix);
+      itk::morea::RenderComparison(problem, forward, options->focus, options->renderPrefix);
   });
 }
 } // namespace morea::cli

@@ -1,13 +1,15 @@
 // `morea register`: preprocesses a problem, runs MOREA and writes the
 // approximation set, the chosen solutions and their scores.
 #include "CommandCommon.h"
-#include "RegistrationOutputs.h"
+#include "ProgressPrinter.h"
 
 #include "FilterRun.h"
 #include "ZipArchive.h"
 
 #include "itkMOREAImageIO.h"
+#include "itkRegistrationOutputs.h"
 #include "morea/ComputeDevices.h"
+#include "morea/OutputFolderLock.h"
 
 #include <chrono>
 #include <csignal>
@@ -36,13 +38,26 @@ struct Options
   std::string                initialTransform;
 };
 
+/** Whether `folder` holds nothing but an output folder's lock file. */
+bool
+OnlyLockFileIn(const std::string & folder)
+{
+  std::error_code ec;
+  for (const auto & entry : std::filesystem::directory_iterator(folder, ec))
+    if (entry.path().filename() != OutputFolderLock::FileName)
+      return false;
+  return !ec;
+}
+
 /** One registration through the filter, its folder written and its scores printed. */
 void
 RegisterOnce(const itk::morea::RegistrationProblem & input, const ParameterSet & parameters, const Options & options,
              const RegistrationFilterType::InitialTransformType * initialTransform, const std::string & folder,
-             const CommandTimes & times)
+             const itk::morea::RegistrationOutputTimes & times)
 {
-  const bool createdFolder = std::filesystem::create_directories(folder);
+  namespace fs = std::filesystem;
+  const bool createdFolder = !fs::exists(folder);
+  std::optional<OutputFolderLock> ownership(std::in_place, folder);
   FilterSettings settings;
   settings.backend = options.backend;
   settings.threads = options.threads;
@@ -66,9 +81,10 @@ RegisterOnce(const itk::morea::RegistrationProblem & input, const ParameterSet &
   catch (...)
   {
     // A run that failed before its first checkpoint leaves no folder behind.
+    ownership.reset();
     std::error_code ec;
-    if (createdFolder && std::filesystem::is_empty(folder, ec))
-      std::filesystem::remove(folder, ec);
+    if (createdFolder && OnlyLockFileIn(folder))
+      fs::remove_all(folder, ec);
     throw;
   }
   const auto & run = filter->GetRegistrationRun();
@@ -94,7 +110,7 @@ RegisterOnce(const itk::morea::RegistrationProblem & input, const ParameterSet &
   for (const auto & note : result.model.report.notes) // e.g. a surface constraint TetGen could not keep
     std::cout << "note: mesh: " << note << "\n";
 
-  const auto summary = WriteRegistrationOutputs(run, parameters, folder, nullptr, &times);
+  const auto summary = itk::morea::WriteRegistrationOutputs(run, parameters, folder, nullptr, &times);
   for (const auto & selected : run.selected)
   {
     const auto & c = selected.choice;

@@ -2,6 +2,7 @@
 
 #include "itkMOREAImageIO.h"
 #include "morea/Error.h"
+#include "morea/OutputFolderLock.h"
 
 #include <zlib.h>
 
@@ -73,7 +74,7 @@ ZipFolder(const std::string & folder)
   const std::string archive = top.string() + ".zip";
   std::vector<fs::path> files;
   for (const auto & entry : fs::recursive_directory_iterator(top))
-    if (entry.is_regular_file())
+    if (entry.is_regular_file() && entry.path().filename() != OutputFolderLock::FileName)
       files.push_back(entry.path());
   std::sort(files.begin(), files.end());
 

@@ -1,33 +1,37 @@
-#include "RegistrationOutputs.h"
+#include "itkRegistrationOutputs.h"
 
+#include "itkContourOverlayRenderer.h"
 #include "itkImageRegionConstIteratorWithIndex.h"
 #include "itkMOREAImageIO.h"
 #include "itkMeshTransforms.h"
-#include "itkMultiObjectiveMeshRegistrationFilterSupport.h"
-#include "itkRegistrationEvaluation.h"
+#include "itkMinimumMaximumImageCalculator.h"
+#include "itkRegistrationMetrics.h"
 #include "morea/Error.h"
-#include "morea/ParetoFront.h"
+#include "itkMOREAFail.h"
 
+#include <algorithm>
 #include <chrono>
-#include <cmath>
-#include <cstdio>
-#include <cstring>
 #include <exception>
+#include <filesystem>
 #include <functional>
 #include <future>
-#include <filesystem>
-#include <iostream>
+#include <regex>
+#include <set>
 #include <sstream>
-#include <unistd.h>
 
-namespace morea::cli
+namespace itk
+{
+namespace morea
 {
 namespace
 {
+/** Where outputs are written before they are moved into the folder whole. */
+constexpr const char * StagingFolderName = ".outputs.partial";
+
 /** Mean |u - truth| in mm over the voxels inside the body (intensity > 0). */
 double
-MeanDisplacementError(const itk::morea::DisplacementFieldType * field, const itk::morea::DisplacementFieldType * truth,
-                      const itk::morea::ImageType * fixed)
+MeanDisplacementError(const DisplacementFieldType * field, const DisplacementFieldType * truth,
+                      const ImageType * fixed)
 {
   using namespace itk::morea;
   double      sum = 0.0;
@@ -45,13 +49,13 @@ MeanDisplacementError(const itk::morea::DisplacementFieldType * field, const itk
 /** Another image object over the same pixel buffer: a writer on another
  *  thread updates only this object's pipeline state, while the rest of the
  *  outputs read the original. */
-itk::morea::DisplacementFieldType::Pointer
-SharingBuffer(const itk::morea::DisplacementFieldType * field)
+DisplacementFieldType::Pointer
+SharingBuffer(const DisplacementFieldType * field)
 {
-  auto view = itk::morea::DisplacementFieldType::New();
+  auto view = DisplacementFieldType::New();
   view->CopyInformation(field);
   view->SetRegions(field->GetBufferedRegion());
-  view->SetPixelContainer(const_cast<itk::morea::DisplacementFieldType::PixelContainer *>(field->GetPixelContainer()));
+  view->SetPixelContainer(const_cast<DisplacementFieldType::PixelContainer *>(field->GetPixelContainer()));
   return view;
 }
 
@@ -109,46 +113,89 @@ private:
   std::vector<std::future<void>> m_Writes;
   std::size_t                    m_Done{ 0 }; ///< m_Writes[0, m_Done) are waited for
 };
+
+void
+WriteJson(const nlohmann::json & json, const std::string & path)
+{
+  WriteTextFile(json.dump(2) + "\n", path);
+}
 } // namespace
 
-std::function<void(const ::morea::GenerationRecord &, std::size_t)>
-ProgressPrinter()
+nlohmann::json
+ScoresToJson(const EvaluationScores & scores)
 {
-  const bool terminal = isatty(fileno(stdout)) != 0;
-  return [terminal](const ::morea::GenerationRecord & r, std::size_t total) {
-    char line[320];
-    std::snprintf(line, sizeof line, "generation %zu/%zu  front %zu  best guidance %.4g  hypervolume %.4f  %.2f s",
-                  r.generation, total, r.archiveSize, r.bestGuidance, r.hypervolume, r.seconds);
-    if (terminal)
-    {
-      const int width = 24;
-      const int done = static_cast<int>(width * static_cast<double>(r.generation) / static_cast<double>(total));
-      std::cout << "\r[" << std::string(static_cast<std::size_t>(done), '#')
-                << std::string(static_cast<std::size_t>(width - done), '.') << "] " << line << "   " << std::flush;
-      if (r.generation == total)
-        std::cout << "\n";
-    }
-    else if (r.generation % 10 == 0 || r.generation == total)
-    {
-      // Logs also say where the generation's time went.
-      const auto & p = r.phaseSeconds;
-      std::snprintf(line + std::strlen(line), sizeof line - std::strlen(line),
-                    " (evaluation %.2f, folds %.2f, acceptance %.2f, sampling %.2f, modelling %.2f, other %.2f)",
-                    p.evaluation, p.foldChecks, p.acceptance, p.sampling, p.modelling, p.bookkeeping);
-      if (r.deviceKernelSeconds > 0.0)
-        std::snprintf(line + std::strlen(line), sizeof line - std::strlen(line), ", device kernels %.2f s",
-                      r.deviceKernelSeconds);
-      std::cout << line << "\n" << std::flush;
-    }
-  };
+  nlohmann::json j;
+  j["border_margin_mm"] = scores.borderMargin;
+  for (const auto & s : scores.structures)
+    j["structures"][s.name] = { { "dice", s.dice },
+                                { "hausdorff_mm", s.hausdorff },
+                                { "hausdorff95_mm", s.hausdorff95 },
+                                { "mean_surface_distance_mm", s.meanSurfaceDistance } };
+  if (scores.hasLandmarks)
+    j["landmarks"] = { { "count", scores.landmarks.errors.size() },
+                       { "outside_domain", scores.landmarksOutside },
+                       { "tre_mean_mm", scores.landmarks.mean },
+                       { "tre_sd_mm", scores.landmarks.standardDeviation },
+                       { "tre_max_mm", scores.landmarks.maximum },
+                       { "tre_mm", scores.landmarks.errors } };
+  j["jacobian_nonpositive_fraction"] = scores.nonPositiveJacobianFraction;
+  if (scores.hasInverse)
+    j["inverse_consistency"] = { { "mean_mm", scores.inverseConsistency.mean },
+                                 { "max_mm", scores.inverseConsistency.maximum } };
+  return j;
 }
 
-nlohmann::json
-WriteRegistrationOutputs(const itk::morea::MultiObjectiveRegistrationRun & run, const ParameterSet & parameters,
-                         const std::string & folder, const itk::morea::DisplacementFieldType * trueFixedToMoving,
-                         const CommandTimes * times)
+void
+RenderComparison(const RegistrationProblem & problem, const DisplacementFieldType * field,
+                 const std::string & focusStructure, const std::string & prefix)
 {
-  using namespace itk::morea;
+  DisplacementFieldType::Pointer identity;
+  if (field == nullptr)
+  {
+    identity = MakeIdentityField(problem.fixedImage);
+    field = identity;
+  }
+  // Fixed contours in green, warped moving contours in magenta; the focus structure first
+  // so that the slice goes through it.
+  std::vector<const Structure *> order;
+  for (const auto & s : problem.structures)
+    if (s.fixedMask && s.movingMask && s.name != "body")
+      order.push_back(&s);
+  std::stable_partition(order.begin(), order.end(), [&](const Structure * s) { return s->name == focusStructure; });
+  std::vector<MaskType::Pointer> warped;
+  std::vector<ContourLayer>      layers;
+  for (const Structure * s : order)
+  {
+    warped.push_back(WarpMask(s->movingMask, field));
+    layers.push_back({ s->fixedMask.GetPointer(), { { 0, 220, 0 } }, s->name + " (fixed)" });
+    layers.push_back({ warped.back().GetPointer(), { { 255, 0, 255 } }, s->name + " (moving, warped)" });
+  }
+  auto range = itk::MinimumMaximumImageCalculator<ImageType>::New();
+  range->SetImage(problem.fixedImage);
+  range->Compute();
+  SliceRenderOptions options;
+  if (range->GetMaximum() <= 1.0f && range->GetMinimum() >= 0.0f)
+  {
+    options.windowMin = 0.0f; // preprocessed images are already windowed to [0,1]
+    options.windowMax = 1.0f;
+  }
+  options.pixelsPerMm = 3.0 / problem.fixedImage->GetSpacing()[0];
+  for (const auto & [axis, name] : { std::pair{ SliceAxis::Axial, "axial" }, { SliceAxis::Coronal, "coronal" },
+                                     { SliceAxis::Sagittal, "sagittal" } })
+  {
+    options.axis = axis;
+    RenderContourOverlay(problem.fixedImage, layers, options, prefix + "_" + name + ".png");
+  }
+}
+
+namespace
+{
+/** Every output but summary.json, written into `folder`; returns the summary. */
+nlohmann::json
+WriteOutputFiles(const MultiObjectiveRegistrationRun & run, const ::morea::ParameterSet & parameters,
+                 const std::string & folder, const DisplacementFieldType * trueFixedToMoving,
+                 const RegistrationOutputTimes * times)
+{
   namespace fs = std::filesystem;
   using Clock = std::chrono::steady_clock;
   const auto outputsStarted = Clock::now();
@@ -163,10 +210,7 @@ WriteRegistrationOutputs(const itk::morea::MultiObjectiveRegistrationRun & run, 
   const auto & result = run.registration;
   const auto & problem = preprocessed.problem;
   const double borderMargin = parameters.GetReal("evaluation_border_margin");
-  fs::create_directories(folder);
   const std::string out = folder + "/";
-  // A completed earlier run's summary must not stand beside this run's files.
-  fs::remove(out + "summary.json");
   WriteTextFile(parameters.ToToml(), out + "parameters.toml");
   WriteRigidTransform(preprocessed.rigidTransform, out + "rigid_fixed_to_moving.tfm");
 
@@ -255,7 +299,7 @@ WriteRegistrationOutputs(const itk::morea::MultiObjectiveRegistrationRun & run, 
     {
       baseline.wait();
       const auto scores = EvaluateRegistration(problem, fields.fixedToMoving, fields.movingToFixed, borderMargin);
-      entry["scores"] = ToJson(scores);
+      entry["scores"] = ScoresToJson(scores);
       if (trueFixedToMoving)
         entry["mean_displacement_error_in_body_mm"] =
           MeanDisplacementError(fields.fixedToMoving, trueFixedToMoving, problem.fixedImage);
@@ -267,7 +311,7 @@ WriteRegistrationOutputs(const itk::morea::MultiObjectiveRegistrationRun & run, 
     summary["solutions"][c.label] = entry;
   }
   if (scored)
-    summary["rigid_baseline"] = ToJson(baseline.get());
+    summary["rigid_baseline"] = ScoresToJson(baseline.get());
   lap(scoreSeconds);
   writes.Wait();
   lap(fileSeconds);
@@ -297,7 +341,78 @@ WriteRegistrationOutputs(const itk::morea::MultiObjectiveRegistrationRun & run, 
     seconds["load"] = times->load;
     seconds["command"] = std::chrono::duration<double>(Clock::now() - times->started).count();
   }
-  WriteJson(summary, out + "summary.json");
   return summary;
 }
-} // namespace morea::cli
+
+/** Whether `entry`, a folder inside a registration's folder, is a chosen
+ *  solution's folder (of this layout). */
+bool
+IsSolutionFolder(const std::filesystem::path & entry)
+{
+  std::error_code ec;
+  return std::filesystem::is_directory(entry, ec) &&
+         (std::filesystem::exists(entry / "fixed_to_moving.h5", ec) ||
+          std::filesystem::exists(entry / "mesh_fixed.vtu", ec));
+}
+
+/** A temporary file or folder of an atomic write (WriteTextFile's
+ *  ".NAME.tmpPID_N.EXT"), or an earlier staging folder. */
+bool
+IsTemporary(const std::string & name)
+{
+  static const std::regex temporary(R"(\..*\.tmp[0-9]+_[0-9]+.*)");
+  return name == StagingFolderName || std::regex_match(name, temporary);
+}
+} // namespace
+
+nlohmann::json
+WriteRegistrationOutputs(const MultiObjectiveRegistrationRun & run, const ::morea::ParameterSet & parameters,
+                         const std::string & folder, const DisplacementFieldType * trueFixedToMoving,
+                         const RegistrationOutputTimes * times)
+{
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::create_directories(folder, ec);
+  if (ec)
+    Fail("cannot create the output folder '" + folder + "': " + ec.message());
+  const fs::path root(folder);
+  // From here on the folder holds no complete result until the new summary.
+  fs::remove(root / RegistrationSummaryFileName, ec);
+  if (ec)
+    Fail("cannot remove the earlier '" + (root / RegistrationSummaryFileName).string() + "': " + ec.message());
+  // Leftovers of earlier runs that stopped while writing: the caller owns the folder.
+  for (const auto & entry : fs::directory_iterator(root))
+    if (IsTemporary(entry.path().filename().string()))
+      fs::remove_all(entry.path(), ec);
+  const fs::path staging = root / StagingFolderName;
+  fs::create_directory(staging, ec);
+  if (ec)
+    Fail("cannot create '" + staging.string() + "': " + ec.message());
+  nlohmann::json summary;
+  try
+  {
+    summary = WriteOutputFiles(run, parameters, staging.string(), trueFixedToMoving, times);
+  }
+  catch (...)
+  {
+    fs::remove_all(staging, ec);
+    throw;
+  }
+  // Publish: earlier solution folders go, the staged files move in (renames
+  // within one folder), and the summary marks the result whole.
+  for (const auto & entry : fs::directory_iterator(root))
+    if (entry.path() != staging && IsSolutionFolder(entry.path()))
+      fs::remove_all(entry.path());
+  for (const auto & entry : fs::directory_iterator(staging))
+  {
+    const fs::path target = root / entry.path().filename();
+    if (fs::is_directory(target))
+      fs::remove_all(target);
+    fs::rename(entry.path(), target);
+  }
+  fs::remove(staging);
+  WriteJson(summary, (root / RegistrationSummaryFileName).string());
+  return summary;
+}
+} // namespace morea
+} // namespace itk

@@ -1,0 +1,17 @@
+// The terminal progress line of `morea register` and `morea demo`.
+#ifndef morea_cli_ProgressPrinter_h
+#define morea_cli_ProgressPrinter_h
+
+#include "morea/MoRvGomea.h"
+
+#include <functional>
+
+namespace morea::cli
+{
+/** A terminal progress line per generation (a bar on a terminal, every 10th
+ *  generation otherwise). */
+std::function<void(const ::morea::GenerationRecord &, std::size_t)>
+ProgressPrinter();
+} // namespace morea::cli
+
+#endif
