@@ -1,17 +1,22 @@
 #!/usr/bin/env python3
-"""The phantom (written by `morea phantom -o PHANTOM`) registered from
-SimpleITK images: the best-guidance solution applied to the moving image and
-masks, its transform written, Dice before and after printed.
+"""MOREA from SimpleITK: the pelvis phantom (or a folder written by
+`morea phantom -o FOLDER`) registered, the best-guidance solution applied to
+the moving image and masks, Dice before and after printed, the transform
+written, and a figure saved: the fixed image with its contours and the warped
+moving ones, and the front.
 
-Usage: register_sitk.py PHANTOM_DIR OUTPUT_DIR [GENERATIONS]
+Usage: register_sitk.py [--phantom FOLDER] [--output FOLDER] [--generations N]
 """
+import argparse
 import pathlib
-import sys
 
 import numpy as np
 import SimpleITK as sitk
 
 import morea
+from morea.plots import save_overview
+
+NAMES = ("bladder", "rectum", "bones")
 
 
 def dice(a, b):
@@ -19,27 +24,39 @@ def dice(a, b):
     return 2.0 * np.logical_and(a, b).sum() / max(1, a.sum() + b.sum())
 
 
-def main(phantom, output, generations=100):
-    phantom, output = pathlib.Path(phantom), pathlib.Path(output)
+def load(folder):
+    if folder is None:
+        case = morea.phantom(spacing=3.0)
+        return case["fixed"], case["moving"], {n: case["structures"][n] for n in NAMES}
+    read = lambda path: sitk.ReadImage(str(pathlib.Path(folder) / path))  # noqa: E731
+    masks = {n: (read(f"fixed_masks/{n}.nii.gz"), read(f"moving_masks/{n}.nii.gz")) for n in NAMES}
+    return read("fixed.nii.gz"), read("moving.nii.gz"), masks
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--phantom", help="a folder written by `morea phantom` (default: made in memory)")
+    parser.add_argument("--output", default="register_sitk_output")
+    parser.add_argument("--generations", type=int, default=100)
+    args = parser.parse_args()
+    output = pathlib.Path(args.output)
     output.mkdir(parents=True, exist_ok=True)
-    read = lambda path: sitk.ReadImage(str(phantom / path))  # noqa: E731
-    fixed, moving = read("fixed.nii.gz"), read("moving.nii.gz")
-    names = ("bladder", "rectum", "bones")
-    masks = {n: (read(f"fixed_masks/{n}.nii.gz"), read(f"moving_masks/{n}.nii.gz")) for n in names}
+    fixed, moving, masks = load(args.phantom)
     result = morea.register(fixed, moving, structures=masks, seed=1,
                             parameters={"ea_population_size": 48, "ea_num_clusters": 4, "ea_archive_size": 200,
-                                        "ea_num_generations": generations, "morea_mesh_num_points": 300,
+                                        "ea_num_generations": args.generations, "morea_mesh_num_points": 300,
                                         "morea_sampling_rate": 0.5, "preprocess_isotropic_spacing": 3.0})
     print(result, result.backend_note)
     best = result.solutions[0]
     sitk.WriteTransform(best.fixed_to_moving, str(output / "fixed_to_moving.h5"))
     sitk.WriteImage(best.resample(moving, default_value=-1000), str(output / "warped_moving.nii.gz"))
+    warped = {n: best.resample(m) for n, (f, m) in masks.items()}
     for n, (f, m) in masks.items():
         before = sitk.Resample(m, f, sitk.Transform(), sitk.sitkNearestNeighbor)
-        print(f"{n:8s} Dice {dice(f, before):.3f} -> {dice(f, best.resample(m)):.3f}")
+        print(f"{n:8s} Dice {dice(f, before):.3f} -> {dice(f, warped[n]):.3f}")
+    save_overview(output / "registration.png", fixed, {n: f for n, (f, m) in masks.items()}, warped, result, best)
+    print(f"written to {output}/: fixed_to_moving.h5, warped_moving.nii.gz, registration.png")
 
 
 if __name__ == "__main__":
-    if len(sys.argv) < 3:
-        sys.exit(__doc__)
-    main(sys.argv[1], sys.argv[2], *(int(a) for a in sys.argv[3:4]))
+    main()

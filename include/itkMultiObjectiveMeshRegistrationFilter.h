@@ -342,6 +342,13 @@ public:
     return m_Run;
   }
 
+  /** The problem the inputs describe (images, structures, body masks,
+   *  landmarks) in the original frames, as a run starts from it: for
+   *  scoring or preprocessing outside a run. Throws when the inputs are
+   *  incomplete (no images; unequal landmark counts). */
+  morea::RegistrationProblem
+  MakeRegistrationProblem() const;
+
   /** The latest generation's statistics (during IterationEvent: the one just run). */
   const GenerationRecordType &
   GetLastGenerationRecord() const

@@ -473,6 +473,31 @@ MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::ToInternalImage
 }
 
 template <typename TFixedImage, typename TMovingImage>
+morea::RegistrationProblem
+MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::MakeRegistrationProblem() const
+{
+  if (!this->GetFixedImage() || !this->GetMovingImage())
+  {
+    itkExceptionMacro("the fixed and the moving image are both needed");
+  }
+  morea::RegistrationProblem problem;
+  problem.fixedImage = ToInternalImage(this->GetFixedImage());
+  problem.movingImage = ToInternalImage(this->GetMovingImage());
+  problem.structures = this->StructuresOfInputs();
+  problem.fixedBodyMask = const_cast<MaskType *>(this->GetFixedBodyMask());
+  problem.movingBodyMask = const_cast<MaskType *>(this->GetMovingBodyMask());
+  problem.fixedLandmarks = morea::detail::ToPointList(this->GetFixedLandmarks());
+  problem.movingLandmarks = morea::detail::ToPointList(this->GetMovingLandmarks());
+  if (problem.fixedLandmarks.size() != problem.movingLandmarks.size())
+  {
+    itkExceptionMacro("landmarks: " << problem.fixedLandmarks.size() << " fixed and "
+                                    << problem.movingLandmarks.size()
+                                    << " moving points; both sets need the same points in the same order");
+  }
+  return problem;
+}
+
+template <typename TFixedImage, typename TMovingImage>
 void
 MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GenerateData()
 {
@@ -490,20 +515,7 @@ MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GenerateData()
   morea::MultiObjectiveRegistrationRun run;
   try
   {
-    morea::RegistrationProblem problem;
-    problem.fixedImage = ToInternalImage(this->GetFixedImage());
-    problem.movingImage = ToInternalImage(this->GetMovingImage());
-    problem.structures = this->StructuresOfInputs();
-    problem.fixedBodyMask = const_cast<MaskType *>(this->GetFixedBodyMask());
-    problem.movingBodyMask = const_cast<MaskType *>(this->GetMovingBodyMask());
-    problem.fixedLandmarks = morea::detail::ToPointList(this->GetFixedLandmarks());
-    problem.movingLandmarks = morea::detail::ToPointList(this->GetMovingLandmarks());
-    if (problem.fixedLandmarks.size() != problem.movingLandmarks.size())
-    {
-      itkExceptionMacro("landmarks: " << problem.fixedLandmarks.size() << " fixed and "
-                                      << problem.movingLandmarks.size()
-                                      << " moving points; both sets need the same points in the same order");
-    }
+    const morea::RegistrationProblem problem = this->MakeRegistrationProblem();
 
     morea::MeshRegistrationOptions options;
     options.checkpointPath = m_CheckpointFile;

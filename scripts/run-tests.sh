@@ -7,11 +7,16 @@ cd "$(dirname "$0")/.."
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
 cmake --build build -j"$(nproc)"
 ctest --test-dir build --output-on-failure -j"$(nproc)"
-# The Python package as users install it: `pip install .` into a fresh venv,
-# then its tests against the installed package (they use build/bin/morea to
-# write the phantom).
+# The Python package as users install it: `pip install .` into a fresh venv
+# (with itk for the itk tests and example), its tests against the installed
+# package (they use build/bin/morea to write the phantom), then both examples.
 venv="$PWD/build/pip-venv"
 rm -rf "$venv"
 /usr/bin/python3 -m venv "$venv"
-"$venv/bin/python" -m pip install -q --disable-pip-version-check . SimpleITK pytest
-(cd build && MOREA_BIN="$PWD/bin/morea" "$venv/bin/python" -m pytest -q -p no:cacheprovider ../wrapping/python/tests)
+"$venv/bin/python" -m pip install -q --disable-pip-version-check ".[itk,test]"
+(cd build && MOREA_BIN="$PWD/bin/morea" "$venv/bin/python" -m pytest -q -p no:cacheprovider \
+  -W ignore::DeprecationWarning ../wrapping/python/tests)
+for example in register_sitk register_itk; do
+  "$venv/bin/python" "examples/$example.py" --generations 3 --output "build/examples/$example"
+  test -s "build/examples/$example/registration.png"
+done

@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <iostream>
 
@@ -210,6 +211,72 @@ TEST(Preprocessing, PhantomIsAlignedCroppedAndWindowed)
     }
   }
   EXPECT_GT(background, 0u);
+}
+
+namespace
+{
+/** The same physical image stored with its x axis reversed and its y and z
+ *  axes swapped (direction a signed permutation). */
+template <typename TImage>
+typename TImage::Pointer
+StoredOtherwise(const TImage * image)
+{
+  const auto size = image->GetLargestPossibleRegion().GetSize();
+  // Output axis 0 runs along -x, axis 1 along z, axis 2 along y.
+  typename TImage::IndexType last{ { static_cast<itk::IndexValueType>(size[0]) - 1, 0, 0 } };
+  typename TImage::PointType origin;
+  image->TransformIndexToPhysicalPoint(last, origin);
+  typename TImage::DirectionType direction;
+  direction.Fill(0.0);
+  direction(0, 0) = -1.0;
+  direction(2, 1) = 1.0;
+  direction(1, 2) = 1.0;
+  auto out = TImage::New();
+  out->SetRegions(typename TImage::SizeType{ { size[0], size[2], size[1] } });
+  out->SetSpacing(typename TImage::SpacingType(
+    std::array<double, 3>{ { image->GetSpacing()[0], image->GetSpacing()[2], image->GetSpacing()[1] } }.data()));
+  out->SetOrigin(origin);
+  out->SetDirection(direction);
+  out->Allocate();
+  itk::ImageRegionIteratorWithIndex<TImage> it(out, out->GetLargestPossibleRegion());
+  for (; !it.IsAtEnd(); ++it)
+  {
+    const auto & o = it.GetIndex();
+    it.Set(image->GetPixel({ { static_cast<itk::IndexValueType>(size[0]) - 1 - o[0], o[2], o[1] } }));
+  }
+  return out;
+}
+} // namespace
+
+TEST(Preprocessing, HowTheAxesAreStoredDoesNotChangeTheResult)
+{
+  ::morea::PhantomOptions options;
+  options.spacing = 4.0;
+  const auto problem = MakePhantomProblem(::morea::PelvisPhantom(options).Generate());
+  auto       other = problem;
+  other.fixedImage = StoredOtherwise(problem.fixedImage.GetPointer());
+  other.movingImage = StoredOtherwise(problem.movingImage.GetPointer());
+  for (auto & s : other.structures)
+  {
+    s.fixedMask = StoredOtherwise(s.fixedMask.GetPointer());
+    s.movingMask = StoredOtherwise(s.movingMask.GetPointer());
+  }
+  PreprocessOptions pre;
+  pre.isotropicSpacing = 4.0;
+  const auto a = Preprocess(problem, pre);
+  const auto b = Preprocess(other, pre);
+  ASSERT_EQ(a.report.size, b.report.size);
+  EXPECT_EQ(a.report.origin, b.report.origin);
+  for (unsigned r = 0; r < 3; ++r)
+  {
+    EXPECT_NEAR(a.rigidTransform->GetOffset()[r], b.rigidTransform->GetOffset()[r], 1e-9);
+    for (unsigned c = 0; c < 3; ++c)
+      EXPECT_NEAR(a.rigidTransform->GetMatrix()(r, c), b.rigidTransform->GetMatrix()(r, c), 1e-9);
+  }
+  itk::ImageRegionConstIterator<ImageType> u(a.problem.movingImage, a.problem.movingImage->GetBufferedRegion());
+  itk::ImageRegionConstIterator<ImageType> v(b.problem.movingImage, b.problem.movingImage->GetBufferedRegion());
+  for (; !u.IsAtEnd(); ++u, ++v)
+    ASSERT_NEAR(u.Get(), v.Get(), 1e-5);
 }
 
 TEST(Preprocessing, UnknownStructuresAndBadOptionsAreErrors)

@@ -4,6 +4,7 @@
 #include "itkImageRegionConstIterator.h"
 #include "itkImageRegionConstIteratorWithIndex.h"
 #include "itkImageRegionIterator.h"
+#include "itkImageRegionIteratorWithIndex.h"
 #include "itkLinearInterpolateImageFunction.h"
 #include "itkMOREAImageIO.h"
 #include "itkRegionOfInterestImageFilter.h"
@@ -12,6 +13,7 @@
 #include "morea/ParameterSet.h"
 
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <chrono>
 #include <cmath>
@@ -331,11 +333,100 @@ ExtractSurfacePoints(const MaskType * mask)
   return points;
 }
 
+namespace
+{
+/** `image` with an identity direction when its direction is a signed
+ *  permutation (axes stored flipped or swapped, as DICOM and NIfTI often
+ *  are): the same voxels, reordered, so the steps that work in index space
+ *  (the rigid stage's shrinking and sampling, bounding boxes) see the same
+ *  image whichever way it was stored. Other images are returned as they are
+ *  (an oblique direction would need interpolation). */
+template <typename TImage>
+typename TImage::Pointer
+AxisAligned(const TImage * image)
+{
+  typename TImage::Pointer same(const_cast<TImage *>(image));
+  if (image == nullptr)
+    return same;
+  const auto &                  direction = image->GetDirection();
+  std::array<unsigned, Dimension> inputAxisOf{}; // output axis k runs along input axis inputAxisOf[k]
+  std::array<bool, Dimension>     flipped{};
+  bool                            identity = true;
+  for (unsigned j = 0; j < Dimension; ++j)
+  {
+    unsigned nonZero = 0, k = 0;
+    for (unsigned r = 0; r < Dimension; ++r)
+      if (std::abs(direction(r, j)) > 1e-9)
+      {
+        ++nonZero;
+        k = r;
+      }
+    if (nonZero != 1 || std::abs(std::abs(direction(k, j)) - 1.0) > 1e-6)
+      return same; // oblique
+    inputAxisOf[k] = j;
+    flipped[j] = direction(k, j) < 0.0;
+    identity = identity && k == j && !flipped[j];
+  }
+  if (identity)
+    return same;
+  const auto                    inSize = image->GetLargestPossibleRegion().GetSize();
+  const auto                    inStart = image->GetLargestPossibleRegion().GetIndex();
+  typename TImage::SizeType     size;
+  typename TImage::SpacingType  spacing;
+  typename TImage::IndexType    firstInput;
+  for (unsigned k = 0; k < Dimension; ++k)
+  {
+    const unsigned j = inputAxisOf[k];
+    size[k] = inSize[j];
+    spacing[k] = image->GetSpacing()[j];
+  }
+  for (unsigned j = 0; j < Dimension; ++j)
+    firstInput[j] = inStart[j] + (flipped[j] ? static_cast<IndexValueType>(inSize[j]) - 1 : 0);
+  typename TImage::PointType origin;
+  image->TransformIndexToPhysicalPoint(firstInput, origin);
+  auto out = TImage::New();
+  out->SetRegions(typename TImage::RegionType(size));
+  out->SetSpacing(spacing);
+  out->SetOrigin(origin);
+  out->Allocate();
+  ImageRegionIteratorWithIndex<TImage> it(out, out->GetLargestPossibleRegion());
+  for (; !it.IsAtEnd(); ++it)
+  {
+    typename TImage::IndexType in;
+    for (unsigned k = 0; k < Dimension; ++k)
+    {
+      const unsigned j = inputAxisOf[k];
+      in[j] = flipped[j] ? firstInput[j] - it.GetIndex()[k] : firstInput[j] + it.GetIndex()[k];
+    }
+    it.Set(image->GetPixel(in));
+  }
+  return out;
+}
+
+/** The problem with every image and mask AxisAligned. */
+RegistrationProblem
+AxisAlignedProblem(const RegistrationProblem & input)
+{
+  RegistrationProblem out = input;
+  out.fixedImage = AxisAligned(input.fixedImage.GetPointer());
+  out.movingImage = AxisAligned(input.movingImage.GetPointer());
+  out.fixedBodyMask = AxisAligned(input.fixedBodyMask.GetPointer());
+  out.movingBodyMask = AxisAligned(input.movingBodyMask.GetPointer());
+  for (auto & s : out.structures)
+  {
+    s.fixedMask = AxisAligned(s.fixedMask.GetPointer());
+    s.movingMask = AxisAligned(s.movingMask.GetPointer());
+  }
+  return out;
+}
+} // namespace
+
 PreprocessResult
-Preprocess(const RegistrationProblem & input, const PreprocessOptions & options)
+Preprocess(const RegistrationProblem & given, const PreprocessOptions & options)
 {
   const auto start = std::chrono::steady_clock::now();
-  input.Validate();
+  given.Validate();
+  const RegistrationProblem input = AxisAlignedProblem(given);
   if (!(options.isotropicSpacing > 0.0))
     Fail("preprocessing: isotropic spacing must be positive");
   if (!(options.windowMax > options.windowMin))

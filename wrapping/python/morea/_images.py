@@ -103,3 +103,63 @@ def field_to_sitk(field):
     image.SetOrigin(origin)
     image.SetDirection(direction)
     return image
+
+
+def to_sitk(image):
+    """An (array, spacing, origin, direction) tuple or Image as a SimpleITK image
+    (a copy: SimpleITK owns its buffers)."""
+    import SimpleITK as sitk
+
+    if not isinstance(image, Image):
+        image = Image(*image)
+    out = sitk.GetImageFromArray(np.asarray(image.array))
+    out.SetSpacing(image.spacing)
+    out.SetOrigin(image.origin)
+    out.SetDirection(image.direction)
+    return out
+
+
+def to_itk(image):
+    """An (array, spacing, origin, direction) tuple or Image as an itk image."""
+    import itk
+
+    if not isinstance(image, Image):
+        image = Image(*image)
+    out = itk.image_from_array(np.ascontiguousarray(image.array))
+    out.SetSpacing(image.spacing)
+    out.SetOrigin(image.origin)
+    out.SetDirection(itk.matrix_from_array(np.reshape(image.direction, (3, 3))))
+    return out
+
+
+OUTPUTS = ("sitk", "itk", "numpy")
+
+
+def to_output(image, output):
+    """An image tuple in the library `output` names: "sitk" (SimpleITK),
+    "itk", or "numpy" (a morea.Image: the array with its geometry)."""
+    if image is None:
+        return None
+    if output == "sitk":
+        return to_sitk(image)
+    if output == "itk":
+        return to_itk(image)
+    if output == "numpy":
+        return image if isinstance(image, Image) else Image(*image)
+    raise ValueError(f"output must be one of {', '.join(OUTPUTS)}, not {output!r}")
+
+
+def field_to_itk(field):
+    """A (array, spacing, origin, direction) field as an itk image of
+    itk.Vector[itk.D, 3], what itk.DisplacementFieldTransform takes."""
+    import itk
+
+    array, spacing, origin, direction = field
+    out = itk.Image[itk.Vector[itk.D, 3], 3].New()
+    out.SetRegions([int(n) for n in np.shape(array)[2::-1]])
+    out.Allocate()
+    itk.array_view_from_image(out)[...] = array
+    out.SetSpacing(spacing)
+    out.SetOrigin(origin)
+    out.SetDirection(itk.matrix_from_array(np.reshape(np.asarray(direction, dtype=float), (3, 3))))
+    return out

@@ -3,7 +3,15 @@
 // geometry. The package (wrapping/python/morea) turns SimpleITK, itk and
 // numpy images into these arrays and the results back into transforms.
 #include "itkImportImageContainer.h"
+#include "itkMeshTransforms.h"
 #include "itkMultiObjectiveMeshRegistrationFilter.h"
+#include "itkPhantomImages.h"
+#include "itkPreprocessing.h"
+#include "itkRTStructureSetIO.h"
+#include "itkRegistrationEvaluation.h"
+#include "itkRegistrationOutputs.h"
+#include "morea/Error.h"
+#include "morea/OutputFolderLock.h"
 
 #include <pybind11/functional.h>
 #include <pybind11/numpy.h>
@@ -124,6 +132,101 @@ FieldToPython(const FieldType * field)
                             data, keep);
   const Geometry g = GeometryOf(field);
   return py::make_tuple(array, g.spacing, g.origin, g.direction);
+}
+
+/** An image as (array (z, y, x), spacing, origin, direction), the array
+ *  sharing the image's buffer (the capsule keeps the image alive). */
+template <typename TImage>
+py::tuple
+ImageToPython(const TImage * image)
+{
+  using Pixel = typename TImage::PixelType;
+  typename TImage::ConstPointer owner(image);
+  const auto                    size = image->GetBufferedRegion().GetSize();
+  py::capsule keep(new typename TImage::ConstPointer(owner),
+                   [](void * p) { delete static_cast<typename TImage::ConstPointer *>(p); });
+  py::array_t<Pixel> array({ static_cast<py::ssize_t>(size[2]), static_cast<py::ssize_t>(size[1]),
+                             static_cast<py::ssize_t>(size[0]) },
+                           image->GetBufferPointer(), keep);
+  const Geometry g = GeometryOf(image);
+  return py::make_tuple(array, g.spacing, g.origin, g.direction);
+}
+
+/** A displacement field from (array (z, y, x, 3), spacing, origin, direction), copied. */
+FieldType::Pointer
+FieldFromPython(const py::array_t<double, py::array::c_style | py::array::forcecast> & array, const Geometry & geometry,
+                const char * what)
+{
+  if (array.ndim() != 4 || array.shape(3) != 3)
+    throw py::value_error(std::string(what) + ": a (z, y, x, 3) array of displacements in mm is needed");
+  auto                field = FieldType::New();
+  FieldType::SizeType size;
+  for (unsigned d = 0; d < 3; ++d)
+    size[d] = static_cast<itk::SizeValueType>(array.shape(2 - d));
+  field->SetRegions(FieldType::RegionType(size));
+  SetGeometry(field.GetPointer(), geometry);
+  field->Allocate();
+  std::copy_n(array.data(), array.size(), reinterpret_cast<double *>(field->GetBufferPointer()));
+  return field;
+}
+
+/** The pre-alignment's matrix (row-major) and offset: T(x) = M x + offset. */
+py::tuple
+LinearToPython(const itk::morea::PreAlignmentTransformType * t)
+{
+  std::array<double, 9> matrix{};
+  std::array<double, 3> offset{};
+  for (unsigned r = 0; r < 3; ++r)
+  {
+    offset[r] = t->GetOffset()[r];
+    for (unsigned c = 0; c < 3; ++c)
+      matrix[3 * r + c] = t->GetMatrix()(r, c);
+  }
+  return py::make_tuple(matrix, offset);
+}
+
+/** A problem's images, structures and landmarks as the package reads them. */
+py::dict
+ProblemToPython(const itk::morea::RegistrationProblem & problem)
+{
+  py::dict out;
+  out["fixed"] = ImageToPython(problem.fixedImage.GetPointer());
+  out["moving"] = ImageToPython(problem.movingImage.GetPointer());
+  py::dict structures;
+  for (const auto & s : problem.structures)
+    structures[py::str(s.name)] =
+      py::make_tuple(s.fixedMask ? py::object(ImageToPython(s.fixedMask.GetPointer())) : py::none(),
+                     s.movingMask ? py::object(ImageToPython(s.movingMask.GetPointer())) : py::none());
+  out["structures"] = structures;
+  auto points = [](const auto & list) {
+    std::vector<std::array<double, 3>> p;
+    for (const auto & q : list)
+      p.push_back({ q[0], q[1], q[2] });
+    return p;
+  };
+  if (!problem.fixedLandmarks.empty())
+    out["landmarks"] = py::make_tuple(points(problem.fixedLandmarks), points(problem.movingLandmarks));
+  return out;
+}
+
+/** Runs `f`, turning ITK's and the library's errors into ValueError with the
+ *  library's message. */
+template <typename F>
+auto
+UserCall(F && f)
+{
+  try
+  {
+    return f();
+  }
+  catch (const itk::ExceptionObject & e)
+  {
+    throw py::value_error(itk::morea::UserMessage(e.GetDescription()));
+  }
+  catch (const ::morea::Error & e)
+  {
+    throw py::value_error(e.what());
+  }
 }
 
 /** One registration: the filter with its inputs, kept together with the
@@ -326,36 +429,104 @@ public:
   py::tuple
   Fields(std::size_t index) const
   {
-    const auto & run = m_Filter->GetRegistrationRun();
-    if (index >= run.registration.front.size())
-      throw py::index_error("solution " + std::to_string(index) + " of a front of " +
-                            std::to_string(run.registration.front.size()));
-    for (const auto & s : run.selected)
-      if (s.choice.index == index)
-        return py::make_tuple(FieldToPython(s.fields.fixedToMoving), FieldToPython(s.fields.movingToFixed));
-    itk::morea::MeshFields fields;
+    const auto fields = FieldsOf(index);
+    return py::make_tuple(FieldToPython(fields.fixedToMoving), FieldToPython(fields.movingToFixed));
+  }
+
+  /** Solution `index` scored on the preprocessed problem (Dice, Hausdorff,
+   *  landmarks, folds, inverse consistency) as JSON text. */
+  std::string
+  Scores(std::size_t index) const
+  {
+    const auto   fields = FieldsOf(index);
+    const auto & problem = FinishedRun().preprocessed.problem;
+    const double margin = m_Filter->GetParameters().GetReal("evaluation_border_margin");
+    py::gil_scoped_release release;
+    return UserCall([&] {
+      return itk::morea::ScoresToJson(
+               itk::morea::EvaluateRegistration(problem, fields.fixedToMoving, fields.movingToFixed, margin))
+        .dump();
+    });
+  }
+
+  /** Writes the run's folder as `morea register` does, with the solutions
+   *  `chosen` ((label, front index) pairs) in it; returns summary.json's text. */
+  std::string
+  Save(const std::string & folder, const std::vector<std::pair<std::string, std::size_t>> & chosen) const
+  {
+    auto run = FinishedRun(); // a copy: its chosen solutions are replaced
+    std::vector<itk::morea::SelectedSolution> selected;
+    for (const auto & [label, index] : chosen)
+    {
+      if (label.empty() || label.find_first_of("/\\") != std::string::npos || label[0] == '.')
+        throw py::value_error("save: '" + label + "' cannot name a solution's folder");
+      itk::morea::SelectedSolution s;
+      s.choice.label = label;
+      s.choice.index = index;
+      s.fields = FieldsOf(index);
+      s.original = itk::morea::MakeOriginalFrameTransforms(s.fields, run.preprocessed.rigidTransform);
+      selected.push_back(std::move(s));
+    }
+    run.selected = std::move(selected);
+    const auto parameters = m_Filter->GetParameters();
+    py::gil_scoped_release release;
+    return UserCall([&] {
+      const ::morea::OutputFolderLock ownership(folder);
+      return itk::morea::WriteRegistrationOutputs(run, parameters, folder).dump();
+    });
+  }
+
+  /** The inputs' problem preprocessed as a run would (the parameters'
+   *  preprocessing keys): images, masks, landmarks, the pre-alignment and a
+   *  report. */
+  py::dict
+  Preprocess() const
+  {
+    const auto problem = UserCall([&] { return m_Filter->MakeRegistrationProblem(); });
+    const auto options = UserCall([&] { return itk::morea::PreprocessOptions::FromParameters(m_Filter->GetParameters()); });
+    itk::morea::PreprocessResult result;
     {
       py::gil_scoped_release release;
-      fields = itk::morea::RasterizeSolution(run.registration.model.topology, run.registration.front[index].mesh,
-                                             run.preprocessed.problem.fixedImage, run.preprocessed.problem.movingImage);
+      result = UserCall([&] { return itk::morea::Preprocess(problem, options); });
     }
-    return py::make_tuple(FieldToPython(fields.fixedToMoving), FieldToPython(fields.movingToFixed));
+    py::dict out = ProblemToPython(result.problem);
+    out["pre_alignment"] = LinearToPython(result.rigidTransform);
+    const auto & r = result.report;
+    py::dict     report;
+    report["crop_structure"] = r.cropStructure;
+    report["rigid_structure"] = r.rigidStructure;
+    report["spacing"] = r.spacing;
+    report["size"] = std::array<std::size_t, 3>{ r.size[0], r.size[1], r.size[2] };
+    report["dropped_structures"] = r.droppedStructures;
+    report["dropped_reasons"] = r.droppedReasons;
+    out["report"] = report;
+    return out;
+  }
+
+  /** The inputs' problem scored under a registration given as fields (each
+   *  (array, geometry) or None: identity / no inverse); JSON text. */
+  std::string
+  Evaluate(std::optional<py::array> fixedToMoving, const Geometry & fixedToMovingGeometry,
+           std::optional<py::array> movingToFixed, const Geometry & movingToFixedGeometry, double borderMargin) const
+  {
+    const auto         problem = UserCall([&] { return m_Filter->MakeRegistrationProblem(); });
+    FieldType::Pointer forward, inverse;
+    if (fixedToMoving)
+      forward = FieldFromPython(*fixedToMoving, fixedToMovingGeometry, "fixed_to_moving");
+    if (movingToFixed)
+      inverse = FieldFromPython(*movingToFixed, movingToFixedGeometry, "moving_to_fixed");
+    if (borderMargin < 0.0)
+      borderMargin = m_Filter->GetParameters().GetReal("evaluation_border_margin");
+    py::gil_scoped_release release;
+    return UserCall(
+      [&] { return itk::morea::ScoresToJson(itk::morea::EvaluateRegistration(problem, forward, inverse, borderMargin)).dump(); });
   }
 
   /** The pre-alignment, fixed -> moving: T(x) = M x + offset. */
   py::tuple
   PreAlignment() const
   {
-    const auto *          t = m_Filter->GetRigidTransform();
-    std::array<double, 9> matrix{};
-    std::array<double, 3> offset{};
-    for (unsigned r = 0; r < 3; ++r)
-    {
-      offset[r] = t->GetOffset()[r];
-      for (unsigned c = 0; c < 3; ++c)
-        matrix[3 * r + c] = t->GetMatrix()(r, c);
-    }
-    return py::make_tuple(matrix, offset);
+    return LinearToPython(m_Filter->GetRigidTransform());
   }
 
   std::string
@@ -379,14 +550,41 @@ private:
   static void
   Call(F && f)
   {
-    try
-    {
+    UserCall([&] {
       f();
-    }
-    catch (const itk::ExceptionObject & e)
-    {
-      throw py::value_error(itk::morea::UserMessage(e.GetDescription()));
-    }
+      return 0;
+    });
+  }
+
+  const itk::morea::MultiObjectiveRegistrationRun &
+  FinishedRun() const
+  {
+    const auto & run = m_Filter->GetRegistrationRun();
+    if (run.registration.front.empty())
+      throw std::runtime_error("the registration has not run");
+    return run;
+  }
+
+  void
+  CheckIndex(std::size_t index) const
+  {
+    const auto & front = FinishedRun().registration.front;
+    if (index >= front.size())
+      throw py::index_error("solution " + std::to_string(index) + " of a front of " + std::to_string(front.size()));
+  }
+
+  /** Solution `index`'s fields: the chosen solutions' as rasterised, others now. */
+  itk::morea::MeshFields
+  FieldsOf(std::size_t index) const
+  {
+    CheckIndex(index);
+    const auto & run = FinishedRun();
+    for (const auto & s : run.selected)
+      if (s.choice.index == index)
+        return s.fields;
+    py::gil_scoped_release release;
+    return itk::morea::RasterizeSolution(run.registration.model.topology, run.registration.front[index].mesh,
+                                         run.preprocessed.problem.fixedImage, run.preprocessed.problem.movingImage);
   }
 
   FilterType::Pointer    m_Filter;
@@ -406,6 +604,50 @@ PYBIND11_MODULE(_morea, m)
     .def_readwrite("spacing", &Geometry::spacing)
     .def_readwrite("origin", &Geometry::origin)
     .def_readwrite("direction", &Geometry::direction);
+  m.def(
+    "phantom",
+    [](double spacing, std::uint64_t seed) {
+      ::morea::PhantomOptions options;
+      options.spacing = spacing;
+      options.seed = seed;
+      const auto phantomCase = UserCall([&] { return ::morea::PelvisPhantom(options).Generate(); });
+      const auto problem = itk::morea::MakePhantomProblem(phantomCase);
+      py::dict   out = ProblemToPython(problem);
+      out["true_fixed_to_moving"] = FieldToPython(itk::morea::ToDisplacementField(phantomCase.fixedToMoving));
+      out["true_moving_to_fixed"] = FieldToPython(itk::morea::ToDisplacementField(phantomCase.movingToFixed));
+      return out;
+    },
+    py::arg("spacing"), py::arg("seed"));
+  m.def(
+    "read_rtstruct",
+    [](const std::string & path, std::array<std::size_t, 3> size, const Geometry & geometry,
+       const std::vector<std::string> & names) {
+      auto reference = MaskType::New();
+      reference->SetRegions(MaskType::RegionType(MaskType::SizeType{ { size[0], size[1], size[2] } }));
+      SetGeometry(reference.GetPointer(), geometry);
+      py::dict out;
+      UserCall([&] {
+        const auto rois = itk::morea::ReadRTStructureSet(path);
+        std::vector<const itk::morea::RTStructureROI *> wanted;
+        for (const auto & name : names)
+          wanted.push_back(&itk::morea::FindROI(rois, name));
+        if (names.empty())
+          for (const auto & roi : rois)
+            wanted.push_back(&roi);
+        for (const auto * roi : wanted)
+        {
+          auto points = itk::morea::ContourPoints(*roi);
+          std::vector<std::array<double, 3>> p;
+          for (const auto & q : points)
+            p.push_back({ q[0], q[1], q[2] });
+          out[py::str(roi->name)] =
+            py::make_tuple(ImageToPython(itk::morea::RasterizeROI(*roi, reference).GetPointer()), p);
+        }
+        return 0;
+      });
+      return out;
+    },
+    py::arg("path"), py::arg("size"), py::arg("geometry"), py::arg("names"));
   py::class_<Registration>(m, "Registration")
     .def(py::init<>())
     .def("set_images", &Registration::SetImages)
@@ -424,6 +666,10 @@ PYBIND11_MODULE(_morea, m)
     .def("choose", &Registration::Choose)
     .def("fields", &Registration::Fields)
     .def("pre_alignment", &Registration::PreAlignment)
+    .def("scores", &Registration::Scores)
+    .def("save", &Registration::Save)
+    .def("preprocess", &Registration::Preprocess)
+    .def("evaluate", &Registration::Evaluate)
     .def_property_readonly("backend_used", &Registration::BackendUsed)
     .def_property_readonly("backend_note", &Registration::BackendNote)
     .def_property_readonly("resumed_at_generation", &Registration::ResumedAtGeneration);
