@@ -11,7 +11,7 @@
 #                  the same configuration, resumable, or several programs compared
 #                  over the same late generations (see below).
 #   Late generations in detail: `morea benchmark ... --from-checkpoint RUNDIR/checkpoint.bin`
-#                  times the generations after a register checkpoint; bench/device-phases.py
+#                  times the generations after a register checkpoint; tools/profiling/device-phases.py
 #                  JSON prints where the device's time went (device_phase_seconds).
 #                  bench/run-device-benchmark.sh late OUTDIR SECONDS BACKEND [GENERATIONS]
 #                  does both on the GPU machine.
@@ -19,12 +19,12 @@
 #                  BACKEND PROGRAM... times early generations from scratch, programs in turns.
 #   Where the host's time goes: bench/run-device-benchmark.sh profile OUTDIR SECONDS BACKEND GENERATIONS
 #                  [morea benchmark options] samples the main thread's call stacks over late
-#                  generations (bench/tools/main-thread-profiler.c); here,
-#                  bench/tools/profile-report.py OUTDIR/main-thread.prof --binary build/bin/morea
+#                  generations (tools/profiling/main-thread-profiler.c); here,
+#                  tools/profiling/profile-report.py OUTDIR/main-thread.prof --binary build/bin/morea
 #                  names the functions (with the build the bundle was made from).
 #   While the device waits: bench/run-device-benchmark.sh timeline OUTDIR SECONDS BACKEND GENERATIONS
 #                  [morea benchmark options] records the device's timeline (CUPTI) and the main
-#                  thread's stacks on one clock; bench/tools/device-gaps.py lists the idle gaps and
+#                  thread's stacks on one clock; tools/profiling/device-gaps.py lists the idle gaps and
 #                  profile-report.py --during shows what the main thread did in them.
 #   Whole runs: bench/run-device-benchmark.sh whole OUTDIR SECONDS BACKEND LABEL PROGRAM [OPTIONS]
 #                  registers from scratch with PROGRAM (e.g. /tmp/b/bin/morea-old) and OPTIONS.
@@ -106,13 +106,13 @@ case "${1:-}" in
     mkdir -p "$stage/abdomen/CB07_masks"
     cp "$DATA"/CB02.mha "$DATA"/CB07.mha "$DATA"/CB02_labels.mha "$DATA"/CB02_labels.txt "$stage/abdomen/"
     cp "$DATA"/CB07_masks/Stomach_duo_CBCT.mha "$DATA"/CB07_masks/Bowel_sm_CBCT.mha "$stage/abdomen/CB07_masks/"
-    cc -O2 -shared -fPIC -o "$stage/main-thread-profiler.so" bench/tools/main-thread-profiler.c
+    cc -O2 -shared -fPIC -o "$stage/main-thread-profiler.so" tools/profiling/main-thread-profiler.c
     libs=(--lib "$stage/main-thread-profiler.so")
     # The timeline tracer, where CUPTI is installed (it travels along).
     cuda=$(dirname "$(dirname "$(readlink -f "$(command -v nvcc)")")")
     cupti=$(ls "$cuda"/lib/libcupti.so.* "$cuda"/lib64/libcupti.so.* "$cuda"/extras/CUPTI/lib64/libcupti.so.* 2>/dev/null | head -1 || true)
     if [ -n "$cupti" ]; then
-      cc -O2 -shared -fPIC -o "$stage/device-timeline.so" bench/tools/device-timeline.c -I "$cuda/include" \
+      cc -O2 -shared -fPIC -o "$stage/device-timeline.so" tools/profiling/device-timeline.c -I "$cuda/include" \
         -I "$cuda/extras/CUPTI/include" "$cupti"
       libs+=(--lib "$stage/device-timeline.so" --lib "$cupti")
     fi
@@ -207,7 +207,7 @@ EOF2
     # Where late generations' time goes: the bundle's morea registers for
     # SECONDS (85 reach generation ~330 on an H100), then `morea benchmark`
     # times GENERATIONS more from that checkpoint; OUTDIR/late.json and the
-    # summary of its device phases (bench/device-phases.py).
+    # summary of its device phases (tools/profiling/device-phases.py).
     out=${2:?output folder}
     seconds=${3:?seconds of the start}
     backend=${4:?backend}
@@ -219,7 +219,7 @@ EOF2
     /tmp/b/bin/morea benchmark "${PROBLEM[@]}" --backends "$backend" \
       --from-checkpoint /tmp/ab/late/checkpoint.bin --generations "$generations" --probe 0 \
       -o "$out/late.json" > "$out/late.log" 2>&1
-    python3 bench/device-phases.py "$out/late.json" "$backend" | tee "$out/late-summary.txt"
+    python3 tools/profiling/device-phases.py "$out/late.json" "$backend" | tee "$out/late-summary.txt"
     ;;
   early)
     # Early generations of several programs, in turns (ROUNDS times each):
@@ -255,10 +255,10 @@ EOF2
   timeline)
     # What the main thread does while the device stands idle: GENERATIONS
     # late generations from a checkpoint of SECONDS, with the device's
-    # timeline (bench/tools/device-timeline.c) and the main thread's stacks
+    # timeline (tools/profiling/device-timeline.c) and the main thread's stacks
     # (main-thread-profiler.c) on one clock. OUTDIR gets the gaps' summary
     # (device-gaps.py), the gaps and the profile; here,
-    # bench/tools/profile-report.py OUTDIR/main-thread.prof --binary build/bin/morea --during OUTDIR/gaps.txt
+    # tools/profiling/profile-report.py OUTDIR/main-thread.prof --binary build/bin/morea --during OUTDIR/gaps.txt
     out=${2:?output folder}
     mkdir -p "$out" /tmp/ab
     unpack_bundle
@@ -267,7 +267,7 @@ EOF2
       late_from_checkpoint "$out/timeline" "${@:3}"
     summary "$out/timeline.json" "$4" timeline
     # The first seconds load the checkpoint and evaluate its population.
-    python3 bench/tools/device-gaps.py /tmp/ab/timeline.txt --from-seconds "${MOREA_TIMELINE_SKIP:-1}" \
+    python3 tools/profiling/device-gaps.py /tmp/ab/timeline.txt --from-seconds "${MOREA_TIMELINE_SKIP:-1}" \
       --write-gaps "$out/gaps.txt" | tee "$out/gaps-summary.txt"
     xz -T0 -c /tmp/ab/timeline.txt > "$out/timeline.txt.xz"
     ;;
@@ -295,7 +295,7 @@ EOF2
           --from-checkpoint /tmp/ab/late-ab/checkpoint.bin -o "$out/$name-$round.json" > "$out/$name-$round.log" 2>&1 ||
           { tail -3 "$out/$name-$round.log"; continue; }
         summary "$out/$name-$round.json" "$backend" "$name"
-        python3 bench/device-phases.py "$out/$name-$round.json" "$backend" 2>/dev/null | sed -n 2p || true
+        python3 tools/profiling/device-phases.py "$out/$name-$round.json" "$backend" 2>/dev/null | sed -n 2p || true
       done
     done
     ;;

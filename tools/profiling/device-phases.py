@@ -2,7 +2,7 @@
 """Summary of one run of a `morea benchmark` JSON (BACKEND, or the first): seconds per
 generation, and per generation the device phases (device_phase_seconds), the
 batch span, the backend's host time and the optimiser's phases.
-Usage: bench/device-phases.py BENCHMARK_JSON [BACKEND]"""
+Usage: tools/profiling/device-phases.py BENCHMARK_JSON [BACKEND]"""
 import json,sys
 d=json.load(open(sys.argv[1]))
 r=d['runs'][sys.argv[2]] if len(sys.argv) > 2 else next(iter(d['runs'].values()))

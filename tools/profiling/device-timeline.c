@@ -3,7 +3,7 @@
  * on). Loaded with LD_PRELOAD; inactive unless MOREA_TIMELINE names the file
  * to write. CUPTI's activity records (kernels, copies, sets, runtime calls)
  * are stamped with CLOCK_MONOTONIC, the clock main-thread-profiler.c stamps
- * its samples with, so that bench/tools/device-gaps.py can tell what the
+ * its samples with, so that tools/profiling/device-gaps.py can tell what the
  * main thread did while the device stood idle. One line per record:
  *   k START END STREAM CORRELATION NAME        a kernel
  *   c START END STREAM CORRELATION KIND BYTES  a copy (CUPTI's copy kind)

@@ -4,7 +4,7 @@
 // kernel. Needs the CUDA runtime and the project's headers only; built where
 // it runs, from the repository root:
 //   nvcc -O3 -std=c++17 -arch=sm_90 -I include -I src/cuda -o texture-footprints \
-//     bench/tools/texture-footprints.cu && ./texture-footprints
+//     tools/profiling/texture-footprints.cu && ./texture-footprints
 // Formats: a 3D float texture (the fetch-rate yardstick's), a 3D 16-bit
 // normalised one (the intensity texels), and 2D layers of 16-bit pairs
 // (slices l - 1 and l in one 32-bit texel, trilinear from one bilinear

@@ -3,7 +3,7 @@
 
 `morea benchmark` reports samples per second over its sampling kernels'
 event spans (set-up included). This reads the CUPTI timeline of the same
-run (bench/tools/device-timeline.c, MOREA_TIMELINE) and its JSON, and prints
+run (tools/profiling/device-timeline.c, MOREA_TIMELINE) and its JSON, and prints
 where the device's sampling time went kernel by kernel, and the rate over
   - the sampling kernel alone (SampleTextureChunks),
   - all sampling kernels' own durations, summed and as a union (kernels of

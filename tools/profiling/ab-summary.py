@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Per program of a `run-device-benchmark.sh ab` run: mean seconds per
 generation and per phase over generations FIRST..LAST of its generations.csv.
-Usage: bench/ab-summary.py ABDIR FIRST LAST"""
+Usage: tools/profiling/ab-summary.py ABDIR FIRST LAST"""
 import csv
 import os
 import sys

@@ -6,7 +6,7 @@
  * waits, so the samples show where the main thread's wall time goes,
  * waits on the device included. Each sample's call stack (return
  * addresses) is kept in memory and written at exit with /proc/self/maps;
- * bench/tools/profile-report.py names the functions. Each sample's "s" line
+ * tools/profiling/profile-report.py names the functions. Each sample's "s" line
  * follows a "t" line with its CLOCK_MONOTONIC time in nanoseconds (the clock
  * of device-timeline.c's records).
  *   cc -O2 -shared -fPIC -o main-thread-profiler.so main-thread-profiler.c
