@@ -2,8 +2,8 @@
 # Bone landmark TRE with and without bones among the guidance structures,
 # with and without the rigidity term (morea_rigid_weight 0), on a case of the
 # phantom suite whose truth is known (bones do not move in its new cases).
-# Per run: the best-guidance solution's mean TRE per landmark kind (bone,
-# wall, organ, soft, all), scored on the preprocessed grid.
+# Per run and chosen solution (best guidance, knee): the mean TRE per
+# landmark kind (bone, wall, organ, soft, all), scored on the preprocessed grid.
 #   bench/run-rigid-structures.sh MOREA OUTDIR [CASE [PARAMETERS.toml [KEY=VALUE...]]]
 # KEY=VALUE pairs override parameters (e.g. ea_num_generations=60).
 # MOREA_RIGID_RUNS picks runs as GUIDANCE:WEIGHT words (default: all four of
@@ -38,7 +38,7 @@ for side in fixed moving; do
 done
 
 number() { sed -n "s/.*\"$1\": *\([-0-9.eE+]*\).*/\1/p" "$2" | head -1; }
-echo "guidance,rigid_weight,seconds,tre_bone_mm,tre_bone_max_mm,tre_wall_mm,tre_organ_mm,tre_soft_mm,tre_all_mm,bladder_dice,jacobian_nonpositive" \
+echo "guidance,rigid_weight,solution,seconds,tre_bone_mm,tre_bone_max_mm,tre_wall_mm,tre_organ_mm,tre_soft_mm,tre_all_mm,bladder_dice,jacobian_nonpositive" \
   >"$out/rigid-structures.csv"
 for guidance in all without-bones; do
   selection=-1
@@ -52,22 +52,23 @@ for guidance in all without-bones; do
     rigid=()
     [ "$weight" = 0 ] && rigid=(--set morea_rigid_weight=0)
     start=$(date +%s.%N)
-    "$morea" register --problem "$out/phantom" -o "$run" --select best-guidance "${settings[@]}" \
+    "$morea" register --problem "$out/phantom" -o "$run" --select best-guidance,knee "${settings[@]}" \
       --set problem_guidance_selection="$selection" "${rigid[@]}" >"$run.log" 2>&1
     seconds=$(awk -v a="$start" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f", b - a }')
-    field="$run/best_guidance/preprocessed_fixed_to_moving.nii.gz"
-    inverse="$run/best_guidance/preprocessed_moving_to_fixed.nii.gz"
-    line="$guidance,$weight,$seconds"
-    for kind in bone wall organ soft all; do
-      "$morea" evaluate --problem "$out/pre" --field "$field" --inverse-field "$inverse" \
-        --fixed-landmarks "$out/landmarks/$kind/fixed_landmarks.txt" \
-        --moving-landmarks "$out/landmarks/$kind/moving_landmarks.txt" -o "$run/tre-$kind.json" >/dev/null
-      line="$line,$(number tre_mean_mm "$run/tre-$kind.json")"
-      [ "$kind" = bone ] && line="$line,$(number tre_max_mm "$run/tre-$kind.json")"
+    for solution in best_guidance knee; do
+      line="$guidance,$weight,$solution,$seconds"
+      for kind in bone wall organ soft all; do
+        "$morea" evaluate --problem "$out/pre" --field "$run/$solution/preprocessed_fixed_to_moving.nii.gz" \
+          --inverse-field "$run/$solution/preprocessed_moving_to_fixed.nii.gz" \
+          --fixed-landmarks "$out/landmarks/$kind/fixed_landmarks.txt" \
+          --moving-landmarks "$out/landmarks/$kind/moving_landmarks.txt" -o "$run/$solution/tre-$kind.json" >/dev/null
+        line="$line,$(number tre_mean_mm "$run/$solution/tre-$kind.json")"
+        [ "$kind" = bone ] && line="$line,$(number tre_max_mm "$run/$solution/tre-$kind.json")"
+      done
+      dice=$(sed -n '/"bladder"/,/}/s/.*"dice": *\([0-9.eE+-]*\).*/\1/p' "$run/$solution/tre-all.json" | head -1)
+      line="$line,$dice,$(number jacobian_nonpositive_fraction "$run/$solution/tre-all.json")"
+      echo "$line" >>"$out/rigid-structures.csv"
     done
-    dice=$(sed -n '/"bladder"/,/}/s/.*"dice": *\([0-9.eE+-]*\).*/\1/p' "$run/tre-all.json" | head -1)
-    line="$line,$dice,$(number jacobian_nonpositive_fraction "$run/tre-all.json")"
-    echo "$line" >>"$out/rigid-structures.csv"
   done
 done
 cat "$out/rigid-structures.csv"

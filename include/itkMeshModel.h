@@ -13,6 +13,7 @@
 #include "itkRegistrationProblem.h"
 #include "morea/MeshGenerator.h"
 #include "morea/ParallelStructure.h"
+#include "morea/RigidityTerm.h"
 
 #include <string>
 #include <vector>
@@ -44,7 +45,9 @@ struct MeshModel
   ::morea::MeshTopology           topology;
   ::morea::ParallelStructure      parallel;
   std::vector<double>             elasticity;      ///< per tetrahedron
-  std::vector<std::string>        structureNames;  ///< indices of base.structures
+  ::morea::RigidityModel          rigidity;        ///< empty without rigid structures
+  std::vector<std::string>        rigidStructureNames; ///< morea_rigid_structures as resolved
+  std::vector<std::string>        structureNames;  ///< indices of base.structures: guidance, then other rigid ones
   MeshModelReport                 report;
 };
 
@@ -55,12 +58,17 @@ GuidanceStructureNames(const RegistrationProblem & problem, const ::morea::Param
 
 /** Builds the mesh model of a preprocessed problem (both images on one grid)
  *  from the morea_mesh_* keys, morea_elasticity_factors (used when
- *  morea_magnitude_metric is "biomechanical") and seed. */
+ *  morea_magnitude_metric is "biomechanical"), morea_rigid_structures with
+ *  morea_rigid_weight (tetrahedra inside those structures' moving masks, by
+ *  the fraction of their elasticity sample points there; rigid structures
+ *  that do not guide contribute contour points to the mesh like guidance
+ *  structures) and seed. */
 MeshModel
 BuildMeshModel(const RegistrationProblem & problem, const ::morea::ParameterSet & parameters);
 
 /** Writes both meshes of `solution` as .vtu files in physical space with cell
- *  data "elasticity" and "signed_volume" and point data "origin" (corner,
+ *  data "elasticity", "rigidity" (the rigidity term's weight, 0 outside
+ *  rigid structures) and "signed_volume" and point data "origin" (corner,
  *  face, random, contour, surface, Steiner, refinement as 0..6) and "structure". */
 void
 WriteSolutionMeshes(const MeshModel & model, const ::morea::DualMesh & solution, const std::string & movingPath,

@@ -20,3 +20,6 @@ for example in register_sitk register_itk; do
   "$venv/bin/python" "examples/$example.py" --generations 3 --output "build/examples/$example"
   test -s "build/examples/$example/registration.png"
 done
+# AddressSanitizer and UndefinedBehaviorSanitizer over the core and mesh
+# tests and a small registration, in build-asan.
+./scripts/run-sanitizers.sh

@@ -263,6 +263,24 @@ TEST(CheckpointIntegrity, AnotherRunsFingerprintIsRefusedNamingTheFirstKey)
   EXPECT_TRUE(Contains(mesh, "(mesh: " + std::to_string(moved.points.size()) + " points, ")) << mesh;
 }
 
+TEST(CheckpointIntegrity, AnotherEvaluationBackendIsRefusedByName)
+{
+  // The texture path's values differ from the CPU's by about 1e-4: a front
+  // continued on the other would mix both. cuda-exact agrees with the CPU.
+  RunFingerprint onTexture, onCpu, onExact;
+  onTexture.AddEvaluationBackend("cuda-texture");
+  onCpu.AddEvaluationBackend("cpu");
+  onExact.AddEvaluationBackend("cuda-exact");
+  Saved saved(onTexture);
+  EXPECT_EQ(saved.Load(saved.bytes, onTexture), "");
+  const std::string message = saved.Load(saved.bytes, onCpu);
+  EXPECT_TRUE(Contains(message, "(evaluation backend: cuda-texture (the texture units' interpolation) in the "
+                                "checkpoint, cpu or cuda-exact (exact interpolation) in this run)"))
+    << message;
+  Saved onCpuSaved(onCpu);
+  EXPECT_EQ(onCpuSaved.Load(onCpuSaved.bytes, onExact), "");
+}
+
 TEST(CheckpointIntegrity, FilesAreWholeAndErrorsNameThem)
 {
   Saved                       saved;

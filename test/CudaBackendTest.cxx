@@ -448,6 +448,58 @@ TEST(CudaEvaluationBackend, RefusalBoundsChangeNoDecision)
   }
 }
 
+// Rigid structures add their term to the magnitude on the device as on the
+// CPU: whole solutions and partial candidates on both paths, and the
+// refusal screen's bound (which sums the magnitude on the device) changes no
+// decision of a run.
+TEST(CudaEvaluationBackend, RigidStructuresAgreeWithTheCpu)
+{
+  MOREA_REQUIRE_CUDA_DEVICE();
+  OptimiserTestProblem problem;
+  GomeaOptions         options = problem.Options(9);
+  options.populationSize = 4;
+  const auto population = problem.InitialPopulation(options);
+  double     plain = 0.0;
+  for (const auto & v : EvaluateAll(*CreateCpuEvaluationBackend(*problem.evaluator, 2), population)[1])
+    plain += v.magnitude;
+  problem.UseRigidSlab();
+  auto cpu = CreateCpuEvaluationBackend(*problem.evaluator, 2);
+  const auto a = EvaluateAll(*cpu, population);
+  double     rigid = 0.0;
+  for (const auto & v : a[1])
+    rigid += v.magnitude;
+  EXPECT_GT(rigid, 1.5 * plain) << "the rigid slab's term should weigh in the test";
+  for (const CudaInterpolation interpolation : { CudaInterpolation::Exact, CudaInterpolation::Texture })
+  {
+    auto        cuda = CreateCudaEvaluationBackend(*problem.evaluator, 2, interpolation);
+    const auto  b = EvaluateAll(*cuda, population);
+    for (std::size_t s = 0; s < population.size(); ++s)
+      for (std::size_t t = 0; t < a[s].size(); ++t)
+        ExpectRelativelyClose(a[s][t].magnitude, b[s][t].magnitude, 1e-9, cuda->Name() + " magnitude");
+    for (std::size_t g = 0; g < 2; ++g)
+    {
+      morea_test::RandomCandidates onCpu(problem, population, problem.parallel.groups[g], 1.5, 41 + g);
+      morea_test::RandomCandidates onGpu(problem, population, problem.parallel.groups[g], 1.5, 41 + g);
+      cpu->EvaluatePartials(onCpu.candidates);
+      cuda->EvaluatePartials(onGpu.candidates);
+      for (std::size_t i = 0; i < onCpu.candidates.size(); ++i)
+        for (std::size_t t = 0; t < onCpu.values[i].size(); ++t)
+        {
+          EXPECT_EQ(onCpu.values[i][t].folded, onGpu.values[i][t].folded) << cuda->Name();
+          ExpectRelativelyClose(onCpu.values[i][t].magnitude, onGpu.values[i][t].magnitude, 1e-9,
+                                cuda->Name() + " candidate magnitude");
+        }
+    }
+  }
+  const GomeaOptions run = problem.Options(31, 12);
+  GomeaOptions       sampleAll = run;
+  sampleAll.boundRefusals = false;
+  auto       backend = CreateCudaEvaluationBackend(*problem.evaluator, 2, CudaInterpolation::Exact);
+  const auto all = RunToEnd(problem, *backend, sampleAll);
+  const auto bounded = RunToEnd(problem, *backend, run);
+  ExpectSameDecisions(all, bounded, "rigid slab, refusal bound");
+}
+
 TEST(CudaEvaluationBackend, TheFirstGroupSplitInTwoBatchesChangesNoDecision)
 {
   // The generation's first group in two batches of half the population:

@@ -56,6 +56,7 @@ struct OptimiserTestProblem
   morea::ParallelStructure             parallel;
   std::unique_ptr<morea::FoldConstraint> constraint;
   std::vector<double>                  elasticity;
+  morea::RigidityModel                 rigidity;
   morea::ObjectiveData                 data;
   std::unique_ptr<morea::TetrahedronEvaluator> evaluator;
 
@@ -133,6 +134,24 @@ struct OptimiserTestProblem
     }
     for (double & w : data.guidanceWeights)
       w /= total;
+  }
+
+  /** A rigid slab: tetrahedra whose centroid has x < 10 mm wholly, those
+   *  with x in [10, 15) half (as if straddling a bone's surface). The
+   *  evaluator then adds the rigidity term with `weight`. */
+  void
+  UseRigidSlab(double weight = 1000.0)
+  {
+    std::vector<double> fraction(topology.NumberOfTetrahedra(), 0.0);
+    for (std::size_t t = 0; t < fraction.size(); ++t)
+    {
+      double x = 0.0;
+      for (std::uint32_t p : topology.Tetrahedra()[t])
+        x += 0.25 * base.points[p][0];
+      fraction[t] = x < 10.0 ? 1.0 : x < 15.0 ? 0.5 : 0.0;
+    }
+    rigidity = morea::BuildRigidityModel(base, fraction, weight);
+    evaluator = std::make_unique<morea::TetrahedronEvaluator>(topology, *constraint, elasticity, rigidity, data);
   }
 
   morea::GomeaOptions

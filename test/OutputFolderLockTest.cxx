@@ -62,13 +62,14 @@ TEST(OutputFolderLock, AnotherProcessHoldingItRefusesAndItsEndFreesTheFolder)
   ASSERT_GE(child, 0);
   if (child == 0)
   {
-    // Holds the folder until the parent closes the pipe, then ends without releasing it itself.
+    // Holds the folder until the parent kills it: it never releases the lock itself.
+    ::close(ready[0]);
     const morea::OutputFolderLock lock(folder.string());
     char                          byte = 1;
     (void)!::write(ready[1], &byte, 1);
     ::close(ready[1]);
-    ::read(ready[0], &byte, 1);
-    ::_exit(0);
+    for (;;)
+      ::pause();
   }
   ::close(ready[1]);
   char byte = 0;

@@ -59,9 +59,13 @@ TEST(TetrahedronObjectives, MagnitudeMatchesTheWholeObjectiveAndSamplesFollowVol
   EXPECT_GT(f.objectives[2], 0.0);
 }
 
-TEST(TetrahedronObjectives, SumOfPartialEvaluationsEqualsFullEvaluation)
+namespace
 {
-  OptimiserTestProblem problem;
+/** Moves every FOS element of a solution in turn, updating its totals by
+ *  partial evaluations only, and compares them with a full evaluation. */
+void
+ExpectPartialEvaluationsSumToTheFullOne(const OptimiserTestProblem & problem)
+{
   const auto           population = problem.InitialPopulation(problem.Options());
   DualMesh             solution = population[1];
   ObjectiveTotals      running = FullTotals(*problem.evaluator, solution);
@@ -105,6 +109,40 @@ TEST(TetrahedronObjectives, SumOfPartialEvaluationsEqualsFullEvaluation)
   EXPECT_EQ(running.sum.samples, full.sum.samples);
   EXPECT_EQ(a.feasible, b.feasible);
   ExpectRelativelyEqual(running.sum.foldValue, full.sum.foldValue, 1e-6);
+}
+} // namespace
+
+TEST(TetrahedronObjectives, SumOfPartialEvaluationsEqualsFullEvaluation)
+{
+  OptimiserTestProblem problem;
+  ExpectPartialEvaluationsSumToTheFullOne(problem);
+}
+
+TEST(TetrahedronObjectives, SumOfPartialEvaluationsEqualsFullEvaluationWithRigidStructures)
+{
+  OptimiserTestProblem problem;
+  problem.UseRigidSlab();
+  ExpectPartialEvaluationsSumToTheFullOne(problem);
+}
+
+TEST(TetrahedronObjectives, RigidStructuresAddTheirTermToTheMagnitude)
+{
+  OptimiserTestProblem problem;
+  const auto           population = problem.InitialPopulation(problem.Options());
+  const DualMesh &     s = population[3];
+  const double         plain = FullTotals(*problem.evaluator, s).ToFitness(problem.topology.NumberOfTetrahedra()).objectives[0];
+  problem.UseRigidSlab();
+  const Fitness f = FullTotals(*problem.evaluator, s).ToFitness(problem.topology.NumberOfTetrahedra());
+  ExpectRelativelyEqual(f.objectives[0],
+                        MagnitudeObjective(problem.topology, s, problem.elasticity, problem.rigidity), 1e-12);
+  EXPECT_GT(f.objectives[0], plain) << "the initial deformations strain the rigid slab";
+  // Emptied, the model the evaluator reads adds nothing; nor did it change
+  // the other objectives.
+  problem.rigidity = {};
+  const Fitness g = FullTotals(*problem.evaluator, s).ToFitness(problem.topology.NumberOfTetrahedra());
+  EXPECT_EQ(g.objectives[0], plain);
+  EXPECT_EQ(g.objectives[1], f.objectives[1]);
+  EXPECT_EQ(g.objectives[2], f.objectives[2]);
 }
 
 TEST(TetrahedronObjectives, BackgroundAgainstTissueCostsOne)

@@ -49,6 +49,11 @@ private:
   std::thread m_Thread;
 };
 
+/** Bytes of device `device`'s memory free now (cudaMemGetInfo); 0 without
+ *  such a device. */
+std::size_t
+CudaFreeMemory(int device);
+
 /** Bytes of device 0's memory in use (total - free); 0 without a device. */
 std::size_t
 CudaMemoryInUse();

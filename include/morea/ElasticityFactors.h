@@ -25,6 +25,12 @@ struct ElasticStructure
 std::vector<std::vector<double>>
 StructureOverlapFractions(const TetrahedralMesh & mesh, const std::vector<const Volume<std::uint8_t> *> & masks);
 
+/** The fraction of each tetrahedron inside any of `masks` (their union):
+ *  the rigid share of a tetrahedron (RigidityTerm.h). Same samples as
+ *  StructureOverlapFractions; all 0 without masks. */
+std::vector<double>
+UnionOverlapFractions(const TetrahedralMesh & mesh, const std::vector<const Volume<std::uint8_t> *> & masks);
+
 /** c_t = sum_s f_s * factor_s + (1 - sum_s f_s) * 1 for masks that do not
  *  overlap; where they do, a sample point inside several masks takes the
  *  mean of their factors. Same samples as StructureOverlapFractions. */

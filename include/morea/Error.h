@@ -1,4 +1,5 @@
-// MultiObjectiveRegistration core: the one exception type the core throws.
+// MultiObjectiveRegistration core: the exception type the core throws, and the
+// one kind of it a caller may want to tell apart.
 #ifndef morea_Error_h
 #define morea_Error_h
 
@@ -14,6 +15,13 @@ public:
   explicit Error(const std::string & message)
     : std::runtime_error(message)
   {}
+};
+/** A device ran out of memory during a run (the CUDA backend's allocations):
+ *  the caller adds what the run was and what to change. */
+class OutOfDeviceMemory : public Error
+{
+public:
+  using Error::Error;
 };
 } // namespace morea
 

@@ -6,6 +6,7 @@
 #ifndef morea_EvaluationBackend_h
 #define morea_EvaluationBackend_h
 
+#include "morea/MemoryEstimate.h"
 #include "morea/MeshRepair.h"
 #include "morea/ParallelStructure.h"
 #include "morea/RefusalBound.h"
@@ -15,6 +16,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -328,6 +330,22 @@ public:
   ClearRefusalScreen()
   {
     m_HasRefusalScreen = false;
+  }
+
+  /** What this backend allocates for a run of `shape` beyond what it holds
+   *  when made (MemoryEstimate.h): the CUDA backend's device and pinned
+   *  buffers for whole evaluations and batches. Nothing by default. */
+  virtual MemoryEstimate
+  MemoryFor(const RunShape & shape) const
+  {
+    static_cast<void>(shape);
+    return {};
+  }
+  /** Bytes free on the backend's device now; empty: it has none. */
+  virtual std::optional<double>
+  FreeDeviceMemory() const
+  {
+    return std::nullopt;
   }
 
   /** Fold checks and repair of later EvaluatePartials calls; the constraint

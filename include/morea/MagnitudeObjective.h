@@ -3,6 +3,7 @@
 #ifndef morea_MagnitudeObjective_h
 #define morea_MagnitudeObjective_h
 
+#include "morea/RigidityTerm.h"
 #include "morea/TetrahedralMesh.h"
 
 #include <array>
@@ -20,10 +21,12 @@ TetrahedronMagnitude(const Tetrahedron & t, const std::vector<Vec3> & source, co
 /** The same for corners given directly (source[i] and target[i] are one point). */
 double
 TetrahedronMagnitude(const std::array<Vec3, 4> & source, const std::array<Vec3, 4> & target, double elasticity);
-/** The whole objective: sum over t of TetrahedronMagnitude / (10 |T|).
- *  `elasticity` holds one factor per tetrahedron (empty: all 1). */
+/** The whole objective: sum over t of TetrahedronMagnitude plus its
+ *  TetrahedronRigidity, divided by 10 |T|. `elasticity` holds one factor per
+ *  tetrahedron (empty: all 1); `rigidity` may be empty (no rigid structures). */
 double
-MagnitudeObjective(const MeshTopology & topology, const DualMesh & solution, const std::vector<double> & elasticity);
+MagnitudeObjective(const MeshTopology & topology, const DualMesh & solution, const std::vector<double> & elasticity,
+                   const RigidityModel & rigidity = {});
 } // namespace morea
 
 #endif

@@ -24,6 +24,7 @@
 #include "morea/ElitistArchive.h"
 #include "morea/EvaluationBackend.h"
 #include "morea/FoldConstraint.h"
+#include "morea/MemoryEstimate.h"
 #include "morea/ParallelStructure.h"
 #include "morea/Random.h"
 #include "morea/RunFingerprint.h"
@@ -86,9 +87,16 @@ struct GomeaOptions
    *  and a checkpoint with another is refused. The optimiser adds the mesh. */
   RunFingerprint fingerprint;
 
-  /** ea_* keys, morea_repair_method and seed. */
+  /** ea_* keys, morea_repair_method and seed; checked (Check). */
   static GomeaOptions
   FromParameters(const ParameterSet & parameters);
+
+  /** Throws morea::Error for options no run can use: fewer than 2
+   *  solutions, more clusters than solutions, no archive, a selection
+   *  fraction outside (0, 1]. Needs no mesh: callers check before meshing,
+   *  and the optimiser checks again. */
+  void
+  Check() const;
 };
 
 /** What one generation achieved (the per-generation log). */
@@ -153,6 +161,13 @@ public:
   MoRvGomea(const TetrahedralMesh & base, const MeshTopology & topology, const ParallelStructure & parallel,
             const FoldConstraint & constraint, EvaluationBackend & backend, const GomeaOptions & options);
   ~MoRvGomea();
+
+  /** The host memory a run of `shape` keeps (MemoryEstimate.h): the
+   *  population with its tetrahedra's values and element sums, three
+   *  batches of candidates, the archive, the distributions and, with
+   *  checkpoints, their buffers. */
+  static MemoryEstimate
+  MemoryFor(const RunShape & shape);
 
   /** Evaluates `population` (size populationSize; folded solutions are
    *  repaired first) and seeds the archive. */

@@ -34,6 +34,13 @@ public:
   void
   AddParameters(const ParameterSet & parameters);
 
+  /** How the backend named `backendName` (EvaluationBackend::Name) samples
+   *  the images, under "evaluation backend": the cpu and cuda-exact backends
+   *  agree to rounding, the texture path (cuda-texture) only within about
+   *  1e-4 per objective, so a front continued on the other would mix both. */
+  void
+  AddEvaluationBackend(const std::string & backendName);
+
   const std::vector<Entry> &
   Entries() const
   {

@@ -8,6 +8,7 @@
 #include "morea/FoldConstraint.h"
 #include "morea/ObjectiveData.h"
 #include "morea/ParetoFront.h"
+#include "morea/RigidityTerm.h"
 #include "morea/TetrahedralMesh.h"
 
 #include <array>
@@ -19,7 +20,7 @@ namespace morea
 /** One tetrahedron's contributions, both directions summed. */
 struct TetrahedronValues
 {
-  double magnitude{ 0.0 }; ///< c_t * sum over 10 edges of (|e_s| - |e_t|)^2
+  double magnitude{ 0.0 }; ///< c_t * sum over 10 edges of (|e_s| - |e_t|)^2, plus its rigidity term
   double intensity{ 0.0 }; ///< sum of h over the samples
   double guidance{ 0.0 };  ///< sum of weighted guidance terms over the samples
   double samples{ 0.0 };   ///< number of samples
@@ -57,6 +58,11 @@ public:
    *  must outlive the evaluator. */
   TetrahedronEvaluator(const MeshTopology & topology, const FoldConstraint & constraint,
                        const std::vector<double> & elasticity, const ObjectiveData & data);
+  /** With rigid structures: `rigidity` (empty: none) adds its term to each
+   *  tetrahedron's magnitude. It must outlive the evaluator too. */
+  TetrahedronEvaluator(const MeshTopology & topology, const FoldConstraint & constraint,
+                       const std::vector<double> & elasticity, const RigidityModel & rigidity,
+                       const ObjectiveData & data);
 
   /** Tetrahedron `t` with the given corners in the source (moving image) and
    *  target (fixed image) meshes. */
@@ -102,6 +108,12 @@ public:
   {
     return *m_Elasticity;
   }
+  /** The rigidity term's per-tetrahedron data, or an empty model. */
+  const RigidityModel &
+  Rigidity() const
+  {
+    return *m_Rigidity;
+  }
 
 private:
   /** Sums over the samples drawn in `from` (seeded by its coordinates),
@@ -114,6 +126,7 @@ private:
   const MeshTopology *  m_Topology;
   const FoldConstraint * m_Constraint;
   const std::vector<double> * m_Elasticity;
+  const RigidityModel *       m_Rigidity;
   const ObjectiveData *  m_Data;
 };
 

@@ -13,6 +13,7 @@
 #include "morea/EvaluationBackend.h"
 #include "morea/FoldConstraint.h"
 #include "morea/InitialPopulation.h"
+#include "morea/MemoryEstimate.h"
 #include "morea/MoRvGomea.h"
 #include "morea/TetrahedronObjectives.h"
 
@@ -49,6 +50,10 @@ TimeBackend(const std::string & name, const itk::morea::MeshModel & model, const
   auto              backend = CreateEvaluationBackend(ParseBackendChoice(name), evaluator, threads);
   gomea.boundRefusals = UsesRefusalBounds(refusalBounds, *backend);
   gomea.threads = threads; // the backend's pool: the two take turns on it
+  gomea.fingerprint.AddEvaluationBackend(backend->Name()); // as morea register's checkpoints
+  const RunShape shape = RunShapeOf(gomea, model.topology, model.parallel);
+  CheckRunMemory(shape, *backend);
+  const MemoryEstimate memoryEstimate = MoRvGomea::MemoryFor(shape) + backend->MemoryFor(shape);
   std::cout << "  backend " << backend->Name() << ": initial population of " << gomea.populationSize << "\n"
             << std::flush;
   auto      start = Clock::now();
@@ -165,6 +170,8 @@ TimeBackend(const std::string & name, const itk::morea::MeshModel & model, const
                       { "samples_per_second_wall", secondsGenerations > 0 ? samples / secondsGenerations : 0.0 },
                       { "samples_per_second_kernel", kernel > 0 ? samples / kernel : 0.0 },
                       { "gpu_memory_peak_bytes", memoryPeak - memoryBefore },
+                      { "gpu_memory_estimate_bytes", memoryEstimate.Device(gomea.populationSize) },
+                      { "host_memory_estimate_bytes", memoryEstimate.Host(gomea.populationSize) },
                       { "device_phase_seconds", DevicePhasesJson(afterInit, total) },
                       { "archive_size", optimiser.Archive().Size() },
                       { "per_generation", perGeneration } };
@@ -215,9 +222,11 @@ AddBenchmarkCommand(CLI::App & app)
   cmd->add_option("--probe", options->probe, "measure the GPU's coherent trilinear fetch rate")->capture_default_str();
   cmd->callback([options] {
     const auto parameters = options->parameters.Load();
+    CheckRunMemory(parameters); // an absurd population before any work
     const auto start = Clock::now();
     const auto input = options->problem.Load();
     const auto preprocessed = itk::morea::Preprocess(input, itk::morea::PreprocessOptions::FromParameters(parameters));
+    itk::morea::CheckGuidanceStructuresKept(preprocessed.report, parameters); // as morea register does
     const auto & r = preprocessed.report;
     const double voxels = static_cast<double>(r.size[0]) * r.size[1] * r.size[2];
     std::cout << "preprocessed: " << r.size[0] << "x" << r.size[1] << "x" << r.size[2] << " = " << voxels
@@ -226,7 +235,7 @@ AddBenchmarkCommand(CLI::App & app)
     const auto model = itk::morea::BuildMeshModel(preprocessed.problem, parameters);
     const ObjectiveData data = itk::morea::BuildObjectiveData(preprocessed.problem, model, parameters);
     const FoldConstraint constraint(model.topology, model.base.points, parameters.GetReal("morea_fold_volume_fraction"));
-    const TetrahedronEvaluator evaluator(model.topology, constraint, model.elasticity, data);
+    const TetrahedronEvaluator evaluator(model.topology, constraint, model.elasticity, model.rigidity, data);
     GomeaOptions               gomea = GomeaOptions::FromParameters(parameters);
     gomea.fingerprint = itk::morea::RunFingerprintOf(preprocessed.problem, parameters); // as morea register's checkpoints
     if (options->drawAhead != "auto")

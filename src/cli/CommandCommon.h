@@ -84,6 +84,9 @@ void
 AddBenchmarkCommand(CLI::App & app);
 void
 AddInfoCommand(CLI::App & app);
+/** `morea parameters` */
+void
+AddParametersCommand(CLI::App & app);
 } // namespace morea::cli
 
 #endif

@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <utility>
 
 namespace morea::cli
 {
@@ -39,6 +40,10 @@ ReportToJson(const itk::morea::MeshModel & model)
   j["parallel_groups"] = model.report.parallelGroups;
   const auto [lo, hi] = std::minmax_element(model.elasticity.begin(), model.elasticity.end());
   j["elasticity_range"] = { model.elasticity.empty() ? 1.0 : *lo, model.elasticity.empty() ? 1.0 : *hi };
+  j["rigid_structures"] = model.rigidStructureNames;
+  j["rigid_tetrahedra"] = model.rigidity.Empty() ? 0 : std::count_if(model.rigidity.weights.begin(),
+                                                                     model.rigidity.weights.end(),
+                                                                     [](double w) { return w > 0.0; });
   j["seconds"] = { { "contour_points", model.report.secondsContourPoints },
                    { "placement", g.secondsPlacement },
                    { "surfaces", g.secondsSurfaces },
@@ -74,7 +79,9 @@ AddMeshCommand(CLI::App & app)
     if (!itk::morea::SameGrid(problem.fixedImage, problem.movingImage))
     {
       std::cout << "the images are on different grids: preprocessing first\n";
-      problem = itk::morea::Preprocess(problem, itk::morea::PreprocessOptions::FromParameters(parameters)).problem;
+      auto preprocessed = itk::morea::Preprocess(problem, itk::morea::PreprocessOptions::FromParameters(parameters));
+      itk::morea::CheckGuidanceStructuresKept(preprocessed.report, parameters); // as morea register does
+      problem = std::move(preprocessed.problem);
     }
     const auto model = itk::morea::BuildMeshModel(problem, parameters);
     std::filesystem::create_directories(options->output);

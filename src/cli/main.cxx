@@ -20,6 +20,7 @@ main(int argc, char ** argv)
   morea::cli::AddDemoCommand(app);
   morea::cli::AddBenchmarkCommand(app);
   morea::cli::AddInfoCommand(app);
+  morea::cli::AddParametersCommand(app);
   try
   {
     app.parse(argc, argv);

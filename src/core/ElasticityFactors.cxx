@@ -80,6 +80,18 @@ StructureOverlapFractions(const TetrahedralMesh & mesh, const std::vector<const 
 }
 
 std::vector<double>
+UnionOverlapFractions(const TetrahedralMesh & mesh, const std::vector<const Volume<std::uint8_t> *> & masks)
+{
+  std::vector<double> fractions(mesh.NumberOfTetrahedra(), 0.0);
+  const auto samples = SampleTetrahedra(mesh, masks, [&](std::size_t t, const std::vector<bool> & inside) {
+    fractions[t] += std::find(inside.begin(), inside.end(), true) != inside.end() ? 1.0 : 0.0;
+  });
+  for (std::size_t t = 0; t < fractions.size(); ++t)
+    fractions[t] = samples[t] ? fractions[t] / static_cast<double>(samples[t]) : 0.0;
+  return fractions;
+}
+
+std::vector<double>
 ComputeElasticityFactors(const TetrahedralMesh & mesh, const std::vector<ElasticStructure> & structures)
 {
   std::vector<const Volume<std::uint8_t> *> masks;

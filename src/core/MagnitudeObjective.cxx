@@ -53,7 +53,8 @@ TetrahedronMagnitude(const Tetrahedron & t, const std::vector<Vec3> & source, co
 }
 
 double
-MagnitudeObjective(const MeshTopology & topology, const DualMesh & solution, const std::vector<double> & elasticity)
+MagnitudeObjective(const MeshTopology & topology, const DualMesh & solution, const std::vector<double> & elasticity,
+                   const RigidityModel & rigidity)
 {
   const std::size_t n = topology.NumberOfTetrahedra();
   if (!elasticity.empty() && elasticity.size() != n)
@@ -61,10 +62,18 @@ MagnitudeObjective(const MeshTopology & topology, const DualMesh & solution, con
                 std::to_string(n) + " tetrahedra");
   if (solution.source.size() != topology.NumberOfPoints() || solution.target.size() != topology.NumberOfPoints())
     throw Error("magnitude objective: the solution's meshes do not match the topology");
+  if (!rigidity.Empty() && rigidity.weights.size() != n)
+    throw Error("magnitude objective: the rigidity model does not match the topology");
   double sum = 0.0;
   for (std::size_t t = 0; t < n; ++t)
-    sum += TetrahedronMagnitude(topology.Tetrahedra()[t], solution.source, solution.target,
-                                elasticity.empty() ? 1.0 : elasticity[t]);
+  {
+    const Tetrahedron & tet = topology.Tetrahedra()[t];
+    sum += TetrahedronMagnitude(tet, solution.source, solution.target, elasticity.empty() ? 1.0 : elasticity[t]) +
+           TetrahedronRigidity(rigidity, t, { solution.source[tet[0]], solution.source[tet[1]],
+                                              solution.source[tet[2]], solution.source[tet[3]] },
+                               { solution.target[tet[0]], solution.target[tet[1]], solution.target[tet[2]],
+                                 solution.target[tet[3]] });
+  }
   return n ? sum / (10.0 * static_cast<double>(n)) : 0.0;
 }
 } // namespace morea

@@ -32,7 +32,26 @@ GomeaOptions::FromParameters(const ParameterSet & p)
   o.steeringThreshold = p.GetReal("ea_adaptive_steering_guidance_threshold");
   o.repair = p.GetString("morea_repair_method") == "gaussian";
   o.seed = static_cast<std::uint64_t>(p.GetInteger("seed"));
+  o.Check();
   return o;
+}
+
+void
+GomeaOptions::Check() const
+{
+  if (populationSize < 2)
+    throw Error("optimiser: the population needs at least 2 solutions");
+  if (numberOfClusters < 1 || archiveCapacity < 1)
+    throw Error("optimiser: at least one cluster and an archive of at least 1 are needed");
+  if (numberOfClusters > populationSize)
+    // Clustering would have to make do with one cluster per solution (fewer
+    // than asked for, without a word): say so instead.
+    throw Error("optimiser: ea_num_clusters = " + std::to_string(numberOfClusters) +
+                " is more than the population (ea_population_size = " + std::to_string(populationSize) +
+                "); every cluster needs solutions of its own: use at most " + std::to_string(populationSize) +
+                " clusters, or a larger population (the paper: 10 clusters of 700 solutions)");
+  if (!(selectionFraction > 0.0 && selectionFraction <= 1.0))
+    throw Error("optimiser: the selection fraction must be in (0, 1]");
 }
 
 MoRvGomea::MoRvGomea(const TetrahedralMesh & base, const MeshTopology & topology, const ParallelStructure & parallel,
@@ -45,19 +64,7 @@ MoRvGomea::MoRvGomea(const TetrahedralMesh & base, const MeshTopology & topology
   , m_Options(options)
   , m_SteeringLimit(std::numeric_limits<double>::infinity())
 {
-  if (options.populationSize < 2)
-    throw Error("optimiser: the population needs at least 2 solutions");
-  if (options.numberOfClusters < 1 || options.archiveCapacity < 1)
-    throw Error("optimiser: at least one cluster and an archive of at least 1 are needed");
-  if (options.numberOfClusters > options.populationSize)
-    // Clustering would have to make do with one cluster per solution (fewer
-    // than asked for, without a word): say so instead.
-    throw Error("optimiser: ea_num_clusters = " + std::to_string(options.numberOfClusters) +
-                " is more than the population (ea_population_size = " + std::to_string(options.populationSize) +
-                "); every cluster needs solutions of its own: use at most " + std::to_string(options.populationSize) +
-                " clusters, or a larger population (the paper: 10 clusters of 700 solutions)");
-  if (!(options.selectionFraction > 0.0 && options.selectionFraction <= 1.0))
-    throw Error("optimiser: the selection fraction must be in (0, 1]");
+  options.Check();
   if (parallel.elements.empty())
     throw Error("optimiser: the mesh has no FOS elements");
   m_Archive = std::make_unique<ElitistArchive>(options.archiveCapacity);

@@ -163,6 +163,8 @@ private:
   {
     if (static_cast<std::size_t>(m_End - m_At) < n)
       throw Error("checkpoint: the file is corrupt (its payload ends early)");
+    if (n == 0) // an empty vector's data() may be null, which memcpy must not get
+      return;
     std::memcpy(to, m_At, n);
     m_At += n;
   }

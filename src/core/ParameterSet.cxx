@@ -80,6 +80,11 @@ MakeSpecs()
          "fraction of the random mesh points placed on the domain's faces (they slide within them)"),
     Text("morea_elasticity_factors", "bones=10, bladder=0.5", {},
          "tissue elasticity factors of the deformation magnitude, structure=factor (others: 1)"),
+    Text("morea_rigid_structures", "auto", {},
+         "structures that keep their shape, guidance or not: \"auto\" (names like bones, femur, femoral head, "
+         "sacrum, vertebra, and elasticity factors >= 10), \"none\", or comma-separated names"),
+    Real("morea_rigid_weight", 1000.0, 0.0, 1e9,
+         "weight of the rigid structures' strain in the deformation magnitude (0: off)"),
     Int("morea_max_num_mesh_levels", 1, 1, 1, "mesh levels (single resolution only)"),
     Int("morea_num_generations_per_level", 0, 0, 0, "generations per mesh level (single resolution: 0)"),
     Text("morea_magnitude_metric", "biomechanical", { "biomechanical", "standard" },

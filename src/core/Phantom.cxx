@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
+#include <string>
 #include <thread>
 
 namespace morea
@@ -20,6 +22,20 @@ constexpr double kFieldOfViewRadius = 180.0;
 constexpr double kBladderCentre[3] = { 0.0, -25.0, -15.0 };
 constexpr double kBladderAxes[3] = { 28.0, 22.0, 20.0 };
 constexpr double kDecayLength = 1.2; // in units of the bladder's normalised radius
+
+// "bladder-emptying": the full bladder of the fixed image, and how far the
+// bowel lies higher to rest on its dome.
+constexpr double kFullBladderCentre[3] = { 0.0, -28.0, -12.0 };
+constexpr double kFullBladderAxes[3] = { 42.0, 32.0, 48.0 };
+constexpr double kFullBladderBowelLift = 8.0;
+// "gas-pocket": the rectal content (3 mm radius) that becomes a gas pocket.
+constexpr double kPocketCentre[3] = { 0.0, 22.0, 12.0 };
+constexpr double kPocketRadius = 3.0;
+// Bounded reach of the deformation, in units of the organ's normalised radius.
+constexpr double kEmptyingReach = 1.6;
+constexpr double kStaticBonesReach = 2.4;
+constexpr double kPocketReach = 6.0;
+constexpr double kRectalGasHu = -900.0;
 
 double
 Square(double x)
@@ -57,10 +73,9 @@ InBones(const Vec3 & x)
 }
 
 bool
-InBladder(const Vec3 & x)
+InBladder(const Vec3 & x, const Vec3 & c, const Vec3 & a)
 {
-  return InEllipsoid(x, kBladderCentre[0], kBladderCentre[1], kBladderCentre[2], kBladderAxes[0], kBladderAxes[1],
-                     kBladderAxes[2]);
+  return InEllipsoid(x, c[0], c[1], c[2], a[0], a[1], a[2]);
 }
 
 bool
@@ -87,20 +102,20 @@ BowelCentreZ(double x)
   return 35.0 + 8.0 * std::cos(x / 18.0);
 }
 bool
-InBowel(const Vec3 & x)
+InBowel(const Vec3 & x, double lift)
 {
   if (x[0] < -75.0 || x[0] > 75.0)
     return false;
   // Distance to the curve, approximated in the local y-z plane (the curve is
   // nearly parallel to x): exact enough for a phantom, and cheap.
-  return Square(x[1] - BowelCentreY(x[0])) + Square(x[2] - BowelCentreZ(x[0])) <= Square(13.0);
+  return Square(x[1] - BowelCentreY(x[0])) + Square(x[2] - (BowelCentreZ(x[0]) + lift)) <= Square(13.0);
 }
 bool
-InBowelGas(const Vec3 & x)
+InBowelGas(const Vec3 & x, double lift)
 {
   for (double cx : { -50.0, -10.0, 30.0, 60.0 })
   {
-    if (Square(x[0] - cx) + Square(x[1] - BowelCentreY(cx)) + Square(x[2] - BowelCentreZ(cx)) <= Square(5.0))
+    if (Square(x[0] - cx) + Square(x[1] - BowelCentreY(cx)) + Square(x[2] - (BowelCentreZ(cx) + lift)) <= Square(5.0))
       return true;
   }
   return false;
@@ -123,15 +138,72 @@ ParallelFor(std::size_t count, const std::function<void(std::size_t)> & body)
 }
 } // namespace
 
+PhantomOptions
+PhantomOptions::OfCase(const std::string & name)
+{
+  const auto & names = PelvisPhantom::CaseNames();
+  if (std::find(names.begin(), names.end(), name) == names.end())
+  {
+    std::string known;
+    for (const auto & n : names)
+      known += (known.empty() ? "" : ", ") + n;
+    throw Error("unknown phantom case " + name + " (known: " + known + ")");
+  }
+  PhantomOptions o;
+  o.caseName = name;
+  if (name == "pelvis")
+    return o;
+  o.translation = { { 0.0, 0.0, 0.0 } };
+  o.rotationDegrees = { { 0.0, 0.0, 0.0 } };
+  o.bladderGrowth = name == "bladder-emptying" ? 0.45 : name == "gas-pocket" ? 3.5 : 1.7;
+  return o;
+}
+
 PelvisPhantom::PelvisPhantom(PhantomOptions options)
   : m_Options(options)
 {
   if (!(m_Options.spacing >= 0.25 && m_Options.spacing <= 10.0))
     throw Error("phantom spacing must be in [0.25, 10] mm");
-  // g'(rho) >= 1 - (k - 1) * sqrt(2) / L * exp(-1/2) outside the bladder, which is
-  // positive only for k < 1 + L * exp(1/2) / sqrt(2) = 2.399 (L = 1.2); 2.35 keeps a margin.
-  if (!(m_Options.bladderGrowth >= 1.0 && m_Options.bladderGrowth <= 2.35))
-    throw Error("phantom bladder growth must be in [1, 2.35]"); // larger growth breaks monotonicity of g
+  PhantomOptions::OfCase(m_Options.caseName); // known name
+  const std::string & name = m_Options.caseName;
+  const double        k = m_Options.bladderGrowth;
+  m_BladderCentre = { { kBladderCentre[0], kBladderCentre[1], kBladderCentre[2] } };
+  m_BladderAxes = { { kBladderAxes[0], kBladderAxes[1], kBladderAxes[2] } };
+  m_Centre = m_BladderCentre;
+  m_Axes = m_BladderAxes;
+  m_Reach = std::numeric_limits<double>::infinity();
+  if (name == "pelvis")
+  {
+    // g'(rho) >= 1 - (k - 1) * sqrt(2) / L * exp(-1/2) outside the bladder, which is
+    // positive only for k < 1 + L * exp(1/2) / sqrt(2) = 2.399 (L = 1.2); 2.35 keeps a margin.
+    if (!(k >= 1.0 && k <= 2.35))
+      throw Error("phantom bladder growth must be in [1, 2.35]"); // larger growth breaks monotonicity of g
+  }
+  else if (name == "bladder-emptying")
+  {
+    m_BladderCentre = { { kFullBladderCentre[0], kFullBladderCentre[1], kFullBladderCentre[2] } };
+    m_BladderAxes = { { kFullBladderAxes[0], kFullBladderAxes[1], kFullBladderAxes[2] } };
+    m_Centre = m_BladderCentre;
+    m_Axes = m_BladderAxes;
+    m_Reach = kEmptyingReach;
+    m_BowelLift = kFullBladderBowelLift;
+    if (!(k >= 0.3 && k <= 1.0))
+      throw Error("phantom bladder growth of bladder-emptying must be in [0.3, 1]");
+  }
+  else
+  {
+    if (name == "gas-pocket")
+    {
+      m_Centre = { { kPocketCentre[0], kPocketCentre[1], kPocketCentre[2] } };
+      m_Axes = { { kPocketRadius, kPocketRadius, kPocketRadius } };
+    }
+    m_Reach = name == "gas-pocket" ? kPocketReach : kStaticBonesReach;
+    // Growth within a bounded reach: g'(rho) >= 1 - (k - 1) pi / (2 (reach - 1)),
+    // kept at 0.05 or more.
+    const double largest = 1.0 + 0.95 * 2.0 * (m_Reach - 1.0) / M_PI;
+    if (!(k >= 1.0 && k <= largest))
+      throw Error("phantom growth of " + name + " must be in [1, " + std::to_string(largest) + "]");
+  }
   if (!(m_Options.noiseSigma >= 0.0))
     throw Error("phantom noise must be non-negative");
   // R = Rz * Ry * Rx.
@@ -165,24 +237,37 @@ PelvisPhantom::StructureNames()
   return names;
 }
 
+const std::vector<std::string> &
+PelvisPhantom::CaseNames()
+{
+  static const std::vector<std::string> names = { "pelvis", "bladder-emptying", "gas-pocket", "static-bones" };
+  return names;
+}
+
 // g(rho): inside the bladder (rho <= 1) a uniform growth by k; outside, the
 // extra displacement decays as a Gaussian of the distance to the wall. With
 // k <= 2.35 and the decay length 1.2, g' > 0 everywhere, so T is invertible.
+// Within a bounded reach R (the other cases) the extra displacement fades as
+// (1 + cos(pi (rho - 1) / (R - 1))) / 2 and is exactly 0 from R on.
 double
 PelvisPhantom::RadialProfile(double rho) const
 {
   const double k = m_Options.bladderGrowth;
   if (rho <= 1.0)
     return k * rho;
-  return rho + (k - 1.0) * std::exp(-Square((rho - 1.0) / kDecayLength));
+  if (std::isinf(m_Reach))
+    return rho + (k - 1.0) * std::exp(-Square((rho - 1.0) / kDecayLength));
+  if (rho >= m_Reach)
+    return rho;
+  return rho + (k - 1.0) * 0.5 * (1.0 + std::cos(M_PI * (rho - 1.0) / (m_Reach - 1.0)));
 }
 
 double
 PelvisPhantom::InverseRadialProfile(double rhoPrime) const
 {
-  // g(rho) lies between rho and k*rho, so the root is in [rho'/k, rho'].
-  double lo = rhoPrime / m_Options.bladderGrowth;
-  double hi = rhoPrime;
+  // g(rho) lies between rho and k*rho, so the root is between rho'/k and rho'.
+  double lo = std::min(rhoPrime / m_Options.bladderGrowth, rhoPrime);
+  double hi = std::max(rhoPrime / m_Options.bladderGrowth, rhoPrime);
   for (int i = 0; i < 60 && hi - lo > 1e-13 * std::max(1.0, hi); ++i)
   {
     const double mid = 0.5 * (lo + hi);
@@ -198,14 +283,16 @@ PelvisPhantom::Expand(const Vec3 & x) const
   double rho2 = 0.0;
   for (int d = 0; d < 3; ++d)
   {
-    u[d] = (x[d] - kBladderCentre[d]) / kBladderAxes[d];
+    u[d] = (x[d] - m_Centre[d]) / m_Axes[d];
     rho2 += u[d] * u[d];
   }
   const double rho = std::sqrt(rho2);
+  if (rho >= m_Reach)
+    return x; // exactly: beyond the reach nothing deforms
   const double scale = rho > 0.0 ? RadialProfile(rho) / rho : m_Options.bladderGrowth;
   Vec3         y;
   for (int d = 0; d < 3; ++d)
-    y[d] = kBladderCentre[d] + kBladderAxes[d] * u[d] * scale;
+    y[d] = m_Centre[d] + m_Axes[d] * u[d] * scale;
   return y;
 }
 
@@ -216,14 +303,16 @@ PelvisPhantom::Contract(const Vec3 & y) const
   double rho2 = 0.0;
   for (int d = 0; d < 3; ++d)
   {
-    u[d] = (y[d] - kBladderCentre[d]) / kBladderAxes[d];
+    u[d] = (y[d] - m_Centre[d]) / m_Axes[d];
     rho2 += u[d] * u[d];
   }
   const double rho = std::sqrt(rho2);
+  if (rho >= m_Reach)
+    return y;
   const double scale = rho > 0.0 ? InverseRadialProfile(rho) / rho : 1.0 / m_Options.bladderGrowth;
   Vec3         x;
   for (int d = 0; d < 3; ++d)
-    x[d] = kBladderCentre[d] + kBladderAxes[d] * u[d] * scale;
+    x[d] = m_Centre[d] + m_Axes[d] * u[d] * scale;
   return x;
 }
 
@@ -264,11 +353,11 @@ PelvisPhantom::InStructure(std::size_t index, const Vec3 & x) const
     case 1:
       return InBones(x);
     case 2:
-      return InBladder(x);
+      return InBladder(x, m_BladderCentre, m_BladderAxes);
     case 3:
       return InRectum(x);
     case 4:
-      return InBowel(x);
+      return InBowel(x, m_BowelLift);
     default:
       throw Error("phantom structure index out of range");
   }
@@ -285,15 +374,25 @@ PelvisPhantom::HounsfieldAt(const Vec3 & x) const
     // something to hold on to inside the bone, as real marrow does.
     return 550.0 + 250.0 * std::sin(x[0] / 1.7) * std::sin(x[1] / 1.3 + 0.5) * std::sin(x[2] / 1.9 + 1.0);
   }
-  if (InBladder(x))
+  if (InBladder(x, m_BladderCentre, m_BladderAxes))
     return 5.0; // urine: low contrast to the surrounding tissue, as in CT
   if (InRectum(x))
-    return InRectalGas(x) ? -900.0 : 50.0;
-  if (InBowel(x))
-    return InBowelGas(x) ? -800.0 : 25.0;
+    return InRectalGas(x) ? kRectalGasHu : 50.0;
+  if (InBowel(x, m_BowelLift))
+    return InBowelGas(x, m_BowelLift) ? -800.0 : 25.0;
   if (!InBody(x, 12.0))
     return -100.0; // subcutaneous fat
   return 40.0;     // soft tissue
+}
+
+double
+PelvisPhantom::MovingHounsfieldAt(const Vec3 & x) const
+{
+  // The rectal content that becomes the gas pocket: gas in the moving image only.
+  if (m_Options.caseName == "gas-pocket" &&
+      InEllipsoid(x, m_Centre[0], m_Centre[1], m_Centre[2], m_Axes[0], m_Axes[1], m_Axes[2]))
+    return kRectalGasHu;
+  return HounsfieldAt(x);
 }
 
 PelvisPhantom::Case
@@ -337,7 +436,7 @@ PelvisPhantom::Generate() const
         // Moving image: the anatomy that T carried to p.
         const Vec3   q = MovingToFixed(p);
         const double nm = movingNoise.Normal() * m_Options.noiseSigma;
-        c.movingImage.data[o] = inView ? static_cast<float>(HounsfieldAt(q) + nm) : OutsideFieldOfView;
+        c.movingImage.data[o] = inView ? static_cast<float>(MovingHounsfieldAt(q) + nm) : OutsideFieldOfView;
         for (int d = 0; d < 3; ++d)
           c.movingToFixed.data[o][d] = q[d] - p[d];
         for (std::size_t s = 0; s < numStructures; ++s)
@@ -345,6 +444,13 @@ PelvisPhantom::Generate() const
       }
   });
 
+  if (m_Options.caseName != "pelvis")
+  {
+    c.fixedLandmarks = SuiteLandmarks(c.landmarkKinds);
+    for (const auto & p : c.fixedLandmarks)
+      c.movingLandmarks.push_back(FixedToMoving(p));
+    return c;
+  }
   // Landmarks on stable bones and on the deforming organs.
   const double bc[3] = { kBladderCentre[0], kBladderCentre[1], kBladderCentre[2] };
   c.fixedLandmarks = {
@@ -368,8 +474,81 @@ PelvisPhantom::Generate() const
     { 0.0, BowelCentreY(0.0), BowelCentreZ(0.0) },
     { 40.0, BowelCentreY(40.0), BowelCentreZ(40.0) },
   };
+  c.landmarkKinds.assign(9, "bone");
+  c.landmarkKinds.resize(13, "wall");
+  c.landmarkKinds.resize(c.fixedLandmarks.size(), "organ");
   for (const auto & p : c.fixedLandmarks)
     c.movingLandmarks.push_back(FixedToMoving(p));
   return c;
+}
+
+std::vector<Vec3>
+PelvisPhantom::SuiteLandmarks(std::vector<std::string> & kinds) const
+{
+  std::vector<Vec3> points;
+  const auto        add = [&](const Vec3 & p, const char * kind) {
+    points.push_back(p);
+    kinds.emplace_back(kind);
+  };
+  // Bone: femoral heads, shafts, iliac wings, sacrum, pubic symphysis.
+  for (double side : { -1.0, 1.0 })
+  {
+    add({ { side * 90.0, 0.0, -35.0 } }, "bone");
+    add({ { side * 90.0, 0.0, -16.0 } }, "bone");
+    add({ { side * 100.0, 0.0, -60.0 } }, "bone");
+    add({ { side * 98.0, 20.0, 25.0 } }, "bone");
+    add({ { side * 98.0, 20.0, 50.0 } }, "bone");
+    add({ { side * 15.0, -88.0, -50.0 } }, "bone");
+  }
+  add({ { 0.0, 85.0, 15.0 } }, "bone");
+  add({ { 0.0, 85.0, -20.0 } }, "bone");
+  add({ { 0.0, -88.0, -50.0 } }, "bone");
+  // Walls: the bladder's along its axes and diagonals (the deforming wall,
+  // but in "gas-pocket"), and the rectum's around the gas pocket.
+  const Vec3 & bc = m_BladderCentre;
+  const Vec3 & ba = m_BladderAxes;
+  for (int a = 0; a < 3; ++a)
+    for (double side : { -1.0, 1.0 })
+    {
+      Vec3 p = bc;
+      p[a] += side * ba[a];
+      add(p, "wall");
+    }
+  for (double sx : { -1.0, 1.0 })
+    for (double sy : { -1.0, 1.0 })
+      for (double sz : { -1.0, 1.0 })
+        add({ { bc[0] + sx * ba[0] / std::sqrt(3.0), bc[1] + sy * ba[1] / std::sqrt(3.0),
+                bc[2] + sz * ba[2] / std::sqrt(3.0) } },
+            "wall");
+  for (double angle : { 0.0, 0.5 * M_PI, M_PI, 1.5 * M_PI })
+    add({ { 15.0 * std::cos(angle), 22.0 + 15.0 * std::sin(angle), kPocketCentre[2] } }, "wall");
+  // Inside organs: the rectum's and the bowel's centre lines (and the gas pocket).
+  for (double z : { -40.0, -10.0, 20.0 })
+    add({ { 0.0, 22.0, z } }, "organ");
+  for (double x : { -40.0, 0.0, 40.0 })
+    add({ { x, BowelCentreY(x), BowelCentreZ(x) + m_BowelLift } }, "organ");
+  if (m_Options.caseName == "gas-pocket")
+    add(m_Centre, "organ");
+  // Soft tissue: a grid through the body, 5 mm or more from every structure.
+  const auto clearOfStructures = [&](const Vec3 & p) {
+    if (!InBody(p, 15.0))
+      return false;
+    for (int a = 0; a < 3; ++a)
+      for (double step : { -5.0, 0.0, 5.0 })
+      {
+        Vec3 q = p;
+        q[a] += step;
+        for (std::size_t s = 1; s < StructureNames().size(); ++s)
+          if (InStructure(s, q))
+            return false;
+      }
+    return true;
+  };
+  for (double z : { -65.0, -25.0, 15.0, 55.0 })
+    for (double y : { -80.0, -50.0, 50.0 })
+      for (double x : { -120.0, -60.0, -30.0, 30.0, 60.0, 120.0 })
+        if (clearOfStructures({ { x, y, z } }))
+          add({ { x, y, z } }, "soft");
+  return points;
 }
 } // namespace morea

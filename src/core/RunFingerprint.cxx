@@ -86,6 +86,13 @@ RunFingerprint::AddParameters(const ParameterSet & parameters)
       Add(spec.key, ParameterText(parameters, spec));
 }
 
+void
+RunFingerprint::AddEvaluationBackend(const std::string & backendName)
+{
+  Add("evaluation backend", backendName == "cuda-texture" ? "cuda-texture (the texture units' interpolation)"
+                                                          : "cpu or cuda-exact (exact interpolation)");
+}
+
 std::string
 RunFingerprint::FirstDifference(const RunFingerprint & current) const
 {

@@ -22,15 +22,31 @@ ObjectiveTotals::ToFitness(std::size_t numberOfTetrahedra) const
   return f;
 }
 
+namespace
+{
+const RigidityModel NoRigidStructures{};
+} // namespace
+
 TetrahedronEvaluator::TetrahedronEvaluator(const MeshTopology & topology, const FoldConstraint & constraint,
                                            const std::vector<double> & elasticity, const ObjectiveData & data)
+  : TetrahedronEvaluator(topology, constraint, elasticity, NoRigidStructures, data)
+{}
+
+TetrahedronEvaluator::TetrahedronEvaluator(const MeshTopology & topology, const FoldConstraint & constraint,
+                                           const std::vector<double> & elasticity, const RigidityModel & rigidity,
+                                           const ObjectiveData & data)
   : m_Topology(&topology)
   , m_Constraint(&constraint)
   , m_Elasticity(&elasticity)
+  , m_Rigidity(&rigidity)
   , m_Data(&data)
 {
   if (!elasticity.empty() && elasticity.size() != topology.NumberOfTetrahedra())
     throw Error("objectives: " + std::to_string(elasticity.size()) + " elasticity factors for " +
+                std::to_string(topology.NumberOfTetrahedra()) + " tetrahedra");
+  if (!rigidity.Empty() && (rigidity.weights.size() != topology.NumberOfTetrahedra() ||
+                            rigidity.inverseEdges.size() != 9 * topology.NumberOfTetrahedra()))
+    throw Error("objectives: the rigidity model does not match the mesh's " +
                 std::to_string(topology.NumberOfTetrahedra()) + " tetrahedra");
   const std::size_t channels = 1 + data.NumberOfGuidanceStructures();
   if (data.fixed.channels != channels || data.moving.channels != channels)
@@ -106,7 +122,8 @@ TetrahedronValues
 TetrahedronEvaluator::EvaluateCorners(std::size_t t, const Corners & source, const Corners & target) const
 {
   TetrahedronValues v;
-  v.magnitude = TetrahedronMagnitude(source, target, m_Elasticity->empty() ? 1.0 : (*m_Elasticity)[t]);
+  v.magnitude = TetrahedronMagnitude(source, target, m_Elasticity->empty() ? 1.0 : (*m_Elasticity)[t]) +
+                TetrahedronRigidity(*m_Rigidity, t, source, target);
   for (const Corners * c : { &source, &target })
   {
     bool folded = false;

@@ -68,4 +68,20 @@ CudaContextWarmUp::~CudaContextWarmUp()
   if (m_Thread.joinable())
     m_Thread.join();
 }
+
+std::size_t
+CudaFreeMemory(int device)
+{
+  // On `device`, then back: the caller's current device stays its own.
+  int current = 0;
+  std::size_t free = 0, total = 0;
+  if (cudaGetDevice(&current) != cudaSuccess || cudaSetDevice(device) != cudaSuccess ||
+      cudaMemGetInfo(&free, &total) != cudaSuccess)
+  {
+    cudaGetLastError();
+    free = 0;
+  }
+  cudaSetDevice(current);
+  return free;
+}
 } // namespace morea

@@ -41,6 +41,11 @@ CudaEvaluationBackend::CudaEvaluationBackend(const TetrahedronEvaluator & evalua
   m_Constants.samplingRate = data.samplingRate;
   m_Constants.voxelVolume = data.voxelVolume;
   m_Constants.elasticity = evaluator.Elasticity().empty() ? nullptr : Upload(evaluator.Elasticity(), m_Elasticity);
+  if (!evaluator.Rigidity().Empty())
+  {
+    m_Constants.rigidWeights = Upload(evaluator.Rigidity().weights, m_RigidWeights);
+    m_Constants.rigidInverseEdges = Upload(evaluator.Rigidity().inverseEdges, m_RigidInverseEdges);
+  }
   m_Constants.referenceVolumes = Upload(evaluator.Constraint().ReferenceVolumes(), m_ReferenceVolumes);
   m_Constants.tetrahedra = static_cast<std::uint32_t>(evaluator.Constraint().ReferenceVolumes().size());
   m_Constants.volumeFraction = evaluator.Constraint().VolumeFraction();
@@ -122,6 +127,56 @@ CudaEvaluationBackend::EvaluateSolutions(const std::vector<const DualMesh *> & s
   RunWhole(f, items);
   UnpackSolutions(f, n, values);
   m_Statistics.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+MemoryEstimate
+CudaEvaluationBackend::MemoryFor(const RunShape & shape) const
+{
+  const double tetrahedra = static_cast<double>(shape.tetrahedra);
+  const double solutionPoints = 6.0 * static_cast<double>(shape.points) * sizeof(double);
+  // Per item of a flight (ReserveItems), on the device and pinned, and the
+  // texture path's set-up workspace and chunk room (ChunkRoomPerItem).
+  double itemDevice = cuda::ItemCorners * sizeof(double) + sizeof(std::uint32_t) + sizeof(std::uint8_t) +
+                      (cuda::ItemValues + 2 * cuda::DirectionValues) * sizeof(double);
+  const double itemPinned = (cuda::ItemValues + 2 * cuda::DirectionValues) * sizeof(double);
+  if (UsesTexturePath())
+  {
+    // Per item and per chunk from a large count: the workspaces' parts are
+    // aligned, and the sort's scratch is nearly linear.
+    constexpr std::size_t many = std::size_t{ 1 } << 20;
+    const ObjectiveData & data = m_Evaluator.Data();
+    const double voxels = static_cast<double>(data.fixed.size[0]) * static_cast<double>(data.fixed.size[1]) *
+                          static_cast<double>(data.fixed.size[2]);
+    // Both directions sample about the domain's voxels times the rate.
+    const double chunksPerItem =
+      tetrahedra > 0.0 ? 2.0 + 2.0 * data.samplingRate * voxels / (tetrahedra * m_Constants.chunkSamples) : 0.0;
+    itemDevice += static_cast<double>(cuda::TexturePrepareWorkspaceBytes(many)) / many +
+                  std::max(FirstChunkRoomPerItem, ChunkRoomMargin * chunksPerItem) *
+                    static_cast<double>(cuda::TextureChunkWorkspaceBytes(many)) / many;
+  }
+  // A candidate's staging on both sides: element, parent, first point,
+  // first item, seeds, fold outcomes, sums and refusal bound.
+  constexpr double candidateBytes = 3 * sizeof(std::uint32_t) + sizeof(std::uint64_t) + 2 * sizeof(std::uint64_t) +
+                                    4 * sizeof(std::uint8_t) + cuda::CandidateSumValues * sizeof(double) +
+                                    sizeof(cuda::CandidateBoundInput) + 2 * sizeof(std::uint32_t);
+  const double batch = static_cast<double>(shape.groupElements) * candidateBytes +
+                       static_cast<double>(shape.groupPoints) * 6.0 * sizeof(double);
+  MemoryEstimate estimate;
+  estimate.device = m_Device;
+  // Two flights, the staged solutions, the parent store (it grows by half
+  // again), and the batches in both flights.
+  estimate.devicePerSolution = 2.0 * tetrahedra * itemDevice + solutionPoints + 1.5 * solutionPoints + 2.0 * batch;
+  estimate.hostPerSolution = 2.0 * tetrahedra * itemPinned + solutionPoints + 2.0 * solutionPoints + 2.0 * batch;
+  return estimate;
+}
+
+std::optional<double>
+CudaEvaluationBackend::FreeDeviceMemory() const
+{
+  const std::size_t free = CudaFreeMemory(m_Device);
+  if (free == 0) // unreadable: a full device still has a little
+    return std::nullopt;
+  return static_cast<double>(free);
 }
 
 void

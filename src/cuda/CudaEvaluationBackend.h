@@ -283,6 +283,15 @@ public:
   EvaluateSolutions(const std::vector<const DualMesh *> & solutions,
                     const std::vector<std::vector<TetrahedronValues> *> & values) override;
 
+  /** Both flights sized for a whole population's items (a full evaluation
+   *  may land in either), its points staged, the parent store and the
+   *  largest batch's candidates. */
+  MemoryEstimate
+  MemoryFor(const RunShape & shape) const override;
+
+  std::optional<double>
+  FreeDeviceMemory() const override;
+
   void
   SetFoldHandling(const FoldHandling & handling) override;
 
@@ -681,6 +690,7 @@ private:
   cuda::DeviceArray<float>      m_Moving, m_Fixed, m_PackedMoving, m_PackedFixed;
   VolumeTextures m_MovingTextures, m_FixedTextures;
   cuda::DeviceArray<double>     m_GuidanceWeights, m_Elasticity, m_ReferenceVolumes;
+  cuda::DeviceArray<double>     m_RigidWeights, m_RigidInverseEdges;
   cuda::PinnedArray<double>        m_HostSolutionPoints; ///< whole solutions' points, staged
   cuda::DeviceArray<double>        m_SolutionPoints;
   // Partial candidates: the mesh once, then per batch (device and staging).

@@ -14,7 +14,8 @@
 
 namespace morea::cuda
 {
-/** Throws morea::Error naming `what` when `status` is not cudaSuccess. */
+/** Throws morea::Error naming `what` when `status` is not cudaSuccess
+ *  (morea::OutOfDeviceMemory when the device's memory is spent). */
 inline void
 Check(cudaError_t status, const char * what)
 {
@@ -22,7 +23,7 @@ Check(cudaError_t status, const char * what)
     return;
   cudaGetLastError(); // clear a non-sticky error so that later calls can go on
   if (status == cudaErrorMemoryAllocation)
-    throw Error(std::string("CUDA backend: out of GPU memory (") + what + ")");
+    throw OutOfDeviceMemory(std::string("CUDA backend: out of GPU memory (") + what + ")");
   throw Error(std::string("CUDA backend: ") + what + ": " + cudaGetErrorString(status));
 }
 

@@ -28,6 +28,12 @@ CudaContextWarmUp::CudaContextWarmUp(int) {}
 CudaContextWarmUp::~CudaContextWarmUp() = default;
 
 std::size_t
+CudaFreeMemory(int)
+{
+  return 0;
+}
+
+std::size_t
 CudaMemoryInUse()
 {
   return 0;

@@ -189,6 +189,48 @@ TetrahedronMagnitude(const double s[12], const double t[12], double elasticity)
   return elasticity * sum;
 }
 
+/** TetrahedronRigidDeviation of morea/RigidityTerm.h, in its order of operations. */
+inline __device__ double
+TetrahedronRigidDeviation(const double s[12], const double t[12], const double * inverseEdges)
+{
+  double gs[9], gt[9];
+  for (int a = 0; a < 3; ++a)
+    for (int j = 0; j < 3; ++j)
+    {
+      double ss = 0.0, st = 0.0;
+      for (int e = 0; e < 3; ++e)
+      {
+        ss += (s[3 * (e + 1) + a] - s[a]) * inverseEdges[3 * e + j];
+        st += (t[3 * (e + 1) + a] - t[a]) * inverseEdges[3 * e + j];
+      }
+      gs[3 * a + j] = ss;
+      gt[3 * a + j] = st;
+    }
+  double sum = 0.0;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+    {
+      double c = 0.0;
+      for (int a = 0; a < 3; ++a)
+        c += gt[3 * a + i] * gt[3 * a + j] - gs[3 * a + i] * gs[3 * a + j];
+      sum += 0.25 * c * c;
+    }
+  return sum;
+}
+
+/** A tetrahedron's whole magnitude term: its edges times its elasticity
+ *  factor, plus its rigidity term (elasticity null: 1 everywhere;
+ *  rigidWeights null: no rigid structures). */
+inline __device__ double
+ItemMagnitude(const double * elasticity, const double * rigidWeights, const double * rigidInverseEdges,
+              std::uint32_t t, const double source[12], const double target[12])
+{
+  double m = TetrahedronMagnitude(source, target, elasticity ? elasticity[t] : 1.0);
+  if (rigidWeights != nullptr && rigidWeights[t] != 0.0)
+    m += rigidWeights[t] * TetrahedronRigidDeviation(source, target, rigidInverseEdges + 9 * static_cast<std::size_t>(t));
+  return m;
+}
+
 inline __device__ double
 WarpSum(double x)
 {
@@ -199,15 +241,16 @@ WarpSum(double x)
 
 /** An item's values besides its samples' (ItemValues' layout: magnitude,
  *  fold value, folded count) for tetrahedron t with corners `source` and
- *  `target`; `elasticity` null: 1 for every tetrahedron. */
+ *  `target`; the magnitude as ItemMagnitude. */
 inline __device__ void
-WriteItemValues(const double * referenceVolumes, double volumeFraction, const double * elasticity, std::uint32_t t,
+WriteItemValues(const double * referenceVolumes, double volumeFraction, const double * elasticity,
+                const double * rigidWeights, const double * rigidInverseEdges, std::uint32_t t,
                 const double source[12], const double target[12], double * out)
 {
   double folded = 0.0;
   double value = VolumeViolation(SignedVolume(source), referenceVolumes[t], volumeFraction, folded);
   value += VolumeViolation(SignedVolume(target), referenceVolumes[t], volumeFraction, folded);
-  out[0] = TetrahedronMagnitude(source, target, elasticity ? elasticity[t] : 1.0);
+  out[0] = ItemMagnitude(elasticity, rigidWeights, rigidInverseEdges, t, source, target);
   out[1] = value;
   out[2] = folded;
 }

@@ -239,8 +239,8 @@ EvaluateTetrahedraKernel(EvaluationConstants k, View moving, View fixed, const d
   out[2] = static_cast<double>(skip == ItemUnused ? 0u : full);
   if (direction == 0) // from = source, to = target
   {
-    WriteItemValues(k.referenceVolumes, k.volumeFraction, k.elasticity, tetrahedra[item], from, to,
-                    itemOut + item * ItemValues);
+    WriteItemValues(k.referenceVolumes, k.volumeFraction, k.elasticity, k.rigidWeights, k.rigidInverseEdges,
+                    tetrahedra[item], from, to, itemOut + item * ItemValues);
   }
 }
 } // namespace

@@ -107,6 +107,10 @@ struct EvaluationConstants
   double          samplingRate{ 1.0 };
   double          voxelVolume{ 1.0 };
   const double *  elasticity{ nullptr };       ///< per tetrahedron, or null (all 1)
+  /** The rigidity term (morea/RigidityTerm.h): per tetrahedron its weight
+   *  and 9 numbers of the base edge matrix's inverse; null without rigid structures. */
+  const double *  rigidWeights{ nullptr };
+  const double *  rigidInverseEdges{ nullptr };
   const double *  referenceVolumes{ nullptr }; ///< signed base volume per tetrahedron
   std::uint32_t   tetrahedra{ 0 };             ///< of the mesh
   double          volumeFraction{ 0.0 };

@@ -278,8 +278,8 @@ PrepareTextureTasks(EvaluationConstants k, const double * __restrict__ corners,
     if (itemIndex != nullptr) // the sort's values, where it sorts
       itemIndex[item] = static_cast<std::uint32_t>(item);
 
-    WriteItemValues(k.referenceVolumes, k.volumeFraction, k.elasticity, tetrahedra[item], source, target,
-                    itemOut + item * ItemValues);
+    WriteItemValues(k.referenceVolumes, k.volumeFraction, k.elasticity, k.rigidWeights, k.rigidInverseEdges,
+                    tetrahedra[item], source, target, itemOut + item * ItemValues);
   }
   __syncthreads();
   auto * out = reinterpret_cast<float4 *>(tasks + 2 * first);

@@ -5,6 +5,7 @@
 #include "morea/ElasticityFactors.h"
 #include "morea/Error.h"
 #include "morea/ParameterSet.h"
+#include "morea/RigidityTerm.h"
 
 #include <algorithm>
 #include <cctype>
@@ -29,6 +30,32 @@ Lower(std::string s)
 {
   std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return s;
+}
+} // namespace
+
+namespace
+{
+/** The rigid structures with a moving mask (morea_rigid_structures; none when
+ *  morea_rigid_weight is 0); `notes` tells of those without one. */
+std::vector<std::string>
+RigidStructureNames(const RegistrationProblem & problem, const ::morea::ParameterSet & parameters,
+                    std::vector<std::string> & notes)
+{
+  std::vector<std::string> names, available;
+  for (const Structure & s : problem.structures)
+    available.push_back(s.name);
+  const auto factors = ::morea::ParseElasticityFactors(parameters.GetString("morea_elasticity_factors"));
+  const auto rigid = ::morea::SelectRigidStructures(parameters.GetString("morea_rigid_structures"), available, factors);
+  if (parameters.GetReal("morea_rigid_weight") == 0.0)
+    return names;
+  for (const std::string & name : rigid)
+  {
+    if (problem.GetStructure(name).movingMask)
+      names.push_back(name);
+    else
+      notes.push_back("no mask for rigid structure " + name + "; not rigid");
+  }
+  return names;
 }
 } // namespace
 
@@ -63,11 +90,26 @@ BuildMeshModel(const RegistrationProblem & problem, const ::morea::ParameterSet 
   model.frame = DomainFrame::Of(problem.movingImage);
   const ::morea::MeshDomain domain = ::morea::MeshDomain::OfGrid(model.frame.GeometryOf(problem.movingImage));
 
-  // The mesh lies on the moving (source) image: its structures' contours and masks.
+  // The mesh lies on the moving (source) image: its structures' contours and
+  // masks. Rigid structures that do not guide get contour points too, so
+  // that tetrahedra can lie inside a bone and stay rigid while those beside
+  // it deform.
   auto                                       start = Clock::now();
   std::vector<::morea::Volume<std::uint8_t>> masks;
   std::vector<::morea::MeshStructure>        structures;
+  std::vector<std::string>                   rigidNotes;
+  try
+  {
+    model.rigidStructureNames = RigidStructureNames(problem, parameters, rigidNotes);
+  }
+  catch (const ::morea::Error & e)
+  {
+    itkGenericExceptionMacro("mesh model: " << e.what());
+  }
   model.structureNames = GuidanceStructureNames(problem, parameters);
+  for (const std::string & name : model.rigidStructureNames)
+    if (std::find(model.structureNames.begin(), model.structureNames.end(), name) == model.structureNames.end())
+      model.structureNames.push_back(name);
   masks.reserve(model.structureNames.size());
   for (const std::string & name : model.structureNames)
   {
@@ -93,6 +135,7 @@ BuildMeshModel(const RegistrationProblem & problem, const ::morea::ParameterSet 
     const auto options = ::morea::MeshGeneratorOptions::FromParameters(parameters);
     model.base = ::morea::GenerateMesh(domain, structures, options, &model.report.generation);
     model.report.notes = model.report.generation.notes;
+    model.report.notes.insert(model.report.notes.end(), rigidNotes.begin(), rigidNotes.end());
 
     start = Clock::now();
     model.topology = ::morea::MeshTopology(model.base.tetrahedra, model.base.NumberOfPoints());
@@ -122,6 +165,19 @@ BuildMeshModel(const RegistrationProblem & problem, const ::morea::ParameterSet 
       }
     }
     model.elasticity = ::morea::ComputeElasticityFactors(model.base, elastic);
+
+    // Rigid structures, guidance or not: the tetrahedra inside their masks.
+    std::vector<::morea::Volume<std::uint8_t>>         rigidMasks;
+    std::vector<const ::morea::Volume<std::uint8_t> *> rigidMaskPointers;
+    rigidMasks.reserve(model.rigidStructureNames.size());
+    for (const std::string & name : model.rigidStructureNames)
+    {
+      rigidMasks.push_back(ToVolume(problem.GetStructure(name).movingMask.GetPointer(), model.frame));
+      rigidMaskPointers.push_back(&rigidMasks.back());
+    }
+    if (!rigidMaskPointers.empty())
+      model.rigidity = ::morea::BuildRigidityModel(model.base, ::morea::UnionOverlapFractions(model.base, rigidMaskPointers),
+                                                   parameters.GetReal("morea_rigid_weight"));
     model.report.secondsElasticity = SecondsSince(start);
   }
   catch (const ::morea::Error & e)
@@ -148,8 +204,11 @@ WriteSolutionMeshes(const MeshModel & model, const ::morea::DualMesh & solution,
     std::vector<double> volume;
     for (const auto & t : model.topology.Tetrahedra())
       volume.push_back(::morea::SignedVolume(t, *points));
+    const std::vector<double> rigidity =
+      model.rigidity.Empty() ? std::vector<double>(model.topology.NumberOfTetrahedra(), 0.0) : model.rigidity.weights;
     WriteMeshVtu(path, model.topology, *points, model.frame,
-                 { { "elasticity", model.elasticity }, { "signed_volume", volume } }, pointData);
+                 { { "elasticity", model.elasticity }, { "rigidity", rigidity }, { "signed_volume", volume } },
+                 pointData);
   }
 }
 } // namespace morea

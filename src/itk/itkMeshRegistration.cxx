@@ -2,9 +2,11 @@
 
 #include "itkObjectiveData.h"
 #include "morea/CheckpointWriter.h"
+#include "morea/Error.h"
 #include "morea/EvaluationBackend.h"
 #include "morea/FoldConstraint.h"
 #include "morea/InitialPopulation.h"
+#include "morea/MemoryEstimate.h"
 #include "morea/ParameterSet.h"
 #include "morea/TetrahedronObjectives.h"
 
@@ -116,7 +118,7 @@ RegisterMeshes(const RegistrationProblem & problem, const ::morea::ParameterSet 
   result.secondsObjectiveData = lap(); // what the mesh did not hide
   const ::morea::FoldConstraint constraint(model.topology, model.base.points,
                                                 parameters.GetReal("morea_fold_volume_fraction"));
-  const ::morea::TetrahedronEvaluator evaluator(model.topology, constraint, model.elasticity, data);
+  const ::morea::TetrahedronEvaluator evaluator(model.topology, constraint, model.elasticity, model.rigidity, data);
   ::morea::BackendRequest request;
   request.choice = options.backend;
   request.device = options.device;
@@ -138,30 +140,54 @@ RegisterMeshes(const RegistrationProblem & problem, const ::morea::ParameterSet 
   const ::morea::RunFingerprint ofProblem = RunFingerprintOf(problem, parameters);
   for (const auto & [key, value] : ofProblem.Entries())
     gomea.fingerprint.Add(key, value);
+  gomea.fingerprint.AddEvaluationBackend(result.backend);
+  ::morea::RunShape shape = ::morea::RunShapeOf(gomea, model.topology, model.parallel);
+  shape.checkpoints = !options.checkpointPath.empty();
+  ::morea::CheckRunMemory(shape, *backend); // before the population exists, not as bad_alloc midway
   ::morea::MoRvGomea optimiser(model.base, model.topology, model.parallel, constraint, *backend, gomea);
-  if (options.resume && !options.checkpointPath.empty() && std::filesystem::exists(options.checkpointPath))
-  {
-    optimiser.LoadCheckpoint(options.checkpointPath);
-    result.resumedAtGeneration = optimiser.Generation();
-  }
-  else
-    optimiser.Initialize(::morea::GenerateInitialPopulation(
-      model.base, constraint, gomea.populationSize, gomea.seed,
-      ::morea::InitialPopulationOptions::FromParameters(parameters)));
   ::morea::CheckpointWriter checkpoints; // files written while the next generations run
-  while (!optimiser.Finished())
+  std::size_t               checkpointGeneration = 0; // of the last checkpoint written; 0: none
+  try
   {
-    optimiser.RunGeneration();
-    const bool last = optimiser.Finished();
-    if (!options.checkpointPath.empty() &&
-        (last || (options.checkpointInterval > 0 && optimiser.Generation() % options.checkpointInterval == 0)))
+    if (options.resume && !options.checkpointPath.empty() && std::filesystem::exists(options.checkpointPath))
     {
-      std::string bytes = checkpoints.TakeBuffer(); // the last checkpoint's room
-      optimiser.CheckpointBytes(bytes);
-      checkpoints.Write(std::move(bytes), options.checkpointPath);
+      optimiser.LoadCheckpoint(options.checkpointPath);
+      result.resumedAtGeneration = checkpointGeneration = optimiser.Generation();
     }
-    if (options.onGeneration)
-      options.onGeneration(optimiser.History().back(), gomea.generations);
+    else
+      optimiser.Initialize(::morea::GenerateInitialPopulation(
+        model.base, constraint, gomea.populationSize, gomea.seed,
+        ::morea::InitialPopulationOptions::FromParameters(parameters)));
+    while (!optimiser.Finished())
+    {
+      optimiser.RunGeneration();
+      const bool last = optimiser.Finished();
+      if (!options.checkpointPath.empty() &&
+          (last || (options.checkpointInterval > 0 && optimiser.Generation() % options.checkpointInterval == 0)))
+      {
+        std::string bytes = checkpoints.TakeBuffer(); // the last checkpoint's room
+        optimiser.CheckpointBytes(bytes);
+        checkpoints.Write(std::move(bytes), options.checkpointPath);
+        checkpointGeneration = optimiser.Generation();
+      }
+      if (options.onGeneration)
+        options.onGeneration(optimiser.History().back(), gomea.generations);
+    }
+  }
+  catch (const ::morea::OutOfDeviceMemory & e)
+  {
+    // Another process took the device's memory, or the estimate fell
+    // short: say what ran out where, and what is left to resume from.
+    checkpoints.Wait();
+    std::string message = std::string(e.what()) + " after " + std::to_string(optimiser.Generation()) +
+                          " generations, with a population of " + std::to_string(gomea.populationSize) +
+                          " (ea_population_size) on a mesh of " + std::to_string(model.base.NumberOfPoints()) +
+                          " points: free the device, lower ea_population_size or morea_mesh_num_points, or run "
+                          "on the cpu backend";
+    if (checkpointGeneration > 0)
+      message += "; the checkpoint " + options.checkpointPath + " (generation " +
+                 std::to_string(checkpointGeneration) + ") resumes on a device with room";
+    throw ::morea::Error(message);
   }
   checkpoints.Wait();
   result.secondsOptimisation = std::chrono::duration<double>(Clock::now() - start).count();

@@ -1,6 +1,7 @@
 #include "itkMultiObjectiveMeshRegistrationFilterSupport.h"
 
 #include "morea/Error.h"
+#include "morea/MemoryEstimate.h"
 #include "morea/ParameterSet.h"
 #include "morea/ParetoFront.h"
 
@@ -174,6 +175,7 @@ RunMultiObjectiveRegistration(const RegistrationProblem & problem, const ::morea
   // Cheap checks first, so that a typo does not surface after the whole run.
   CheckSolutionSelection(selection);
   CheckSingleRunParameters(parameters);
+  ::morea::CheckRunMemory(parameters); // an absurd population at once; RegisterMeshes checks the whole run
   MeshRegistrationOptions registration = options;
   registration.device = static_cast<int>(parameters.GetInteger("cuda_gpu_id"));
   registration.minimumComputeLevel = static_cast<int>(parameters.GetInteger("cuda_compute_level"));

@@ -386,6 +386,12 @@ expect_failure("mesh: negative elasticity factor" OUTPUTS ${o} FRAGMENTS "morea_
   ARGS mesh --fixed "${fixed}" --moving "${moving}" ${blob} --set "morea_elasticity_factors=blob=-2" -o "${o}")
 expect_failure("mesh: unknown guidance structure" OUTPUTS ${o} FRAGMENTS "liver"
   ARGS mesh --fixed "${fixed}" --moving "${moving}" ${blob} --set problem_guidance_selection=liver -o "${o}")
+expect_failure("mesh: unknown rigid structure" OUTPUTS ${o} FRAGMENTS "morea_rigid_structures" "femur" "blob"
+  ARGS mesh --fixed "${fixed}" --moving "${moving}" ${blob} --set morea_rigid_structures=femur -o "${o}")
+expect_failure("mesh: negative rigid weight" OUTPUTS ${o} FRAGMENTS "morea_rigid_weight"
+  ARGS mesh --fixed "${fixed}" --moving "${moving}" ${blob} --set morea_rigid_weight=-1 -o "${o}")
+expect_failure("phantom: unknown case" OUTPUTS "${WORK}/phantom-knee" FRAGMENTS "knee" "bladder-emptying"
+  ARGS phantom --case knee -o "${WORK}/phantom-knee")
 
 # --- register ------------------------------------------------------------------------------------------
 set(o "${WORK}/register-out")
@@ -419,6 +425,18 @@ expect_failure("register: more clusters than solutions" OUTPUTS ${o}
   ARGS register --fixed "${fixed}" --moving "${moving}" ${blob} --set ea_population_size=8 --set ea_num_clusters=9
        --set ea_num_generations=1 --set morea_mesh_num_points=40 --set preprocess_rigid_structure=none --backend cpu
        -o "${o}")
+# A population no machine holds: refused from the parameters, before any work, naming the key.
+expect_failure("register: a population too large for the memory" OUTPUTS ${o}
+  FRAGMENTS "not enough memory" "a population of 10000000 \\(ea_population_size\\)" "lower ea_population_size"
+  ARGS register --fixed "${fixed}" --moving "${moving}" ${blob} --set ea_population_size=10000000
+       --set ea_num_generations=1 --backend cpu -o "${o}")
+# morea benchmark preprocesses as register does, and refuses a vanished structure alike.
+expect_failure("benchmark: a structure that vanishes in preprocessing" OUTPUTS "${WORK}/benchmark-vanished.json"
+  FRAGMENTS "structure 'corner' vanished in preprocessing"
+  ARGS benchmark --fixed "${fixed}" --moving "${moving}" ${blob} --fixed-structure "corner=${in}/corner.mha"
+       --moving-structure "corner=${in}/corner.mha" --set preprocess_crop_structure=blob --set preprocess_crop_margin=2
+       --set ea_population_size=8 --set ea_num_clusters=2 --set morea_mesh_num_points=40
+       --set preprocess_rigid_structure=none --backends cpu --probe 0 -o "${WORK}/benchmark-vanished.json")
 file(WRITE "${WORK}/initial-2d.tfm" "#Insight Transform File V1.0\n#Transform 0\nTransform: AffineTransform_double_2_2\n"
   "Parameters: 1 0 0 1 0 0\nFixedParameters: 0 0\n")
 expect_failure("register: a 2-D initial transform" OUTPUTS ${o} FRAGMENTS "initial moving transform" "3-D transform"

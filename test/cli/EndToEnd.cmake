@@ -94,6 +94,17 @@ file(GLOB leftovers "${phantom}/.*" "${phantom}/*/.*")
 if(leftovers)
   message(FATAL_ERROR "phantom: temporary files were left behind: ${leftovers}")
 endif()
+# A case of the suite: its name and one kind per landmark in phantom.json.
+set(emptying "${WORK}/phantom-emptying")
+morea_ok("phantom --case" phantom --case bladder-emptying -o "${emptying}" --spacing 6)
+file(READ "${emptying}/phantom.json" emptying_json)
+string(JSON emptying_case GET "${emptying_json}" case)
+string(JSON emptying_kinds LENGTH "${emptying_json}" landmark_kinds)
+file(STRINGS "${emptying}/fixed_landmarks.txt" emptying_lines)
+list(GET emptying_lines 1 emptying_count)
+if(NOT emptying_case STREQUAL "bladder-emptying" OR NOT emptying_kinds EQUAL emptying_count OR emptying_count LESS 40)
+  message(FATAL_ERROR "phantom --case: case '${emptying_case}', ${emptying_kinds} landmark kinds for ${emptying_count} landmarks")
+endif()
 
 # --- preprocess -------------------------------------------------------------------------------------
 set(pre "${WORK}/pre")
