@@ -285,15 +285,55 @@ TEST(Preprocessing, UnknownStructuresAndBadOptionsAreErrors)
   options.spacing = 5.0;
   const auto problem = MakePhantomProblem(::morea::PelvisPhantom(options).Generate());
   PreprocessOptions pre;
+  // Errors name the parameter key that named the structure.
+  const auto messageOf = [&](const PreprocessOptions & o) {
+    try
+    {
+      Preprocess(problem, o);
+    }
+    catch (const itk::ExceptionObject & e)
+    {
+      return std::string(e.GetDescription());
+    }
+    return std::string();
+  };
   pre.rigidStructure = "femur";
-  EXPECT_THROW(Preprocess(problem, pre), itk::ExceptionObject);
+  EXPECT_NE(messageOf(pre).find("preprocess_rigid_structure = 'femur'"), std::string::npos) << messageOf(pre);
   pre.rigidStructure = "none";
   pre.cropStructure = "kidney";
-  EXPECT_THROW(Preprocess(problem, pre), itk::ExceptionObject);
+  EXPECT_NE(messageOf(pre).find("preprocess_crop_structure = 'kidney'"), std::string::npos) << messageOf(pre);
   pre.cropStructure = "";
   pre.windowMin = 100.0f;
   pre.windowMax = -100.0f;
   EXPECT_THROW(Preprocess(problem, pre), itk::ExceptionObject);
+}
+
+TEST(Preprocessing, AnAbsurdSpacingIsRefusedWithTheFigures)
+{
+  ::morea::PhantomOptions options;
+  options.spacing = 5.0;
+  auto problem = MakePhantomProblem(::morea::PelvisPhantom(options).Generate());
+  // A header in metres read as millimetres, a thousandfold: the grid would be astronomically large.
+  auto huge = problem.fixedImage->GetSpacing();
+  huge.Fill(5000.0);
+  problem.fixedImage->SetSpacing(huge);
+  PreprocessOptions pre;
+  pre.rigidStructure = "none";
+  pre.cropStructure = "bladder";
+  for (auto & s : problem.structures)
+    if (s.fixedMask)
+      s.fixedMask->SetSpacing(huge);
+  try
+  {
+    Preprocess(problem, pre);
+    FAIL() << "an absurd spacing was accepted";
+  }
+  catch (const itk::ExceptionObject & e)
+  {
+    const std::string what = e.GetDescription();
+    EXPECT_NE(what.find("the preprocessed grid would hold"), std::string::npos) << what;
+    EXPECT_NE(what.find("fixed 5000 x 5000 x 5000 mm"), std::string::npos) << what;
+  }
 }
 
 TEST(Preprocessing, MaskBoundingBoxOfVoxelsAtRowEndsInARegionNotAtTheOrigin)

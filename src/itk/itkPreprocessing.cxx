@@ -403,6 +403,25 @@ AxisAligned(const TImage * image)
   return out;
 }
 
+/** More voxels than a preprocessed grid can reasonably hold (4 GiB of floats). */
+constexpr double MaximumGridVoxels = 1.0e9;
+
+/** The structure a parameter names; an error naming the key otherwise. */
+const Structure &
+NamedStructure(const RegistrationProblem & problem, const std::string & name, const char * key)
+{
+  std::string known;
+  for (const auto & s : problem.structures)
+  {
+    if (s.name == name)
+      return s;
+    known += (known.empty() ? "" : ", ") + s.name;
+  }
+  Fail(std::string(key) + " = '" + name + "', but there is no structure called '" + name +
+       "' (known: " + (known.empty() ? std::string("none") : known) + "); name one of them" +
+       (std::string(key) == "preprocess_rigid_structure" ? ", give an initial transform, or set it to none" : ""));
+}
+
 /** The problem with every image and mask AxisAligned. */
 RegistrationProblem
 AxisAlignedProblem(const RegistrationProblem & input)
@@ -447,13 +466,26 @@ Preprocess(const RegistrationProblem & given, const PreprocessOptions & options)
   }
   else if (!options.rigidStructure.empty() && options.rigidStructure != "none")
   {
-    const Structure & s = input.GetStructure(options.rigidStructure);
+    const Structure & s = NamedStructure(input, options.rigidStructure, "preprocess_rigid_structure");
     if (s.fixedMask.IsNull() || s.movingMask.IsNull())
       Fail("rigid pre-alignment structure '" + s.name + "' needs masks on both images");
     RigidAlignmentOptions rigidOptions;
     rigidOptions.intensityClampMin = std::max(options.windowMin, options.fieldOfViewThreshold);
     rigidOptions.intensityClampMax = options.windowMax;
-    rigid = AlignRigidly(s.fixedMask, s.movingMask, rigidOptions, &report.rigid, input.fixedImage, input.movingImage);
+    try
+    {
+      rigid = AlignRigidly(s.fixedMask, s.movingMask, rigidOptions, &report.rigid, input.fixedImage, input.movingImage);
+    }
+    catch (const ExceptionObject & e)
+    {
+      const std::string what = e.GetDescription();
+      // ITK's v4 registration says so when the mask leaves it no sample point.
+      const bool tooSmall = what.find("must have 1 or more points") != std::string::npos;
+      Fail("rigid pre-alignment on '" + s.name + "' (preprocess_rigid_structure): " +
+           (tooSmall ? "the structure is too small to align on these images; name a larger structure, give an "
+                       "initial transform, or set preprocess_rigid_structure = none (" + what + ")"
+                     : what));
+    }
     report.rigidStructure = s.name;
   }
   result.rigidTransform = rigid;
@@ -474,7 +506,7 @@ Preprocess(const RegistrationProblem & given, const PreprocessOptions & options)
     report.cropStructure = options.cropStructure.empty() ? LargestDeformingStructure(input) : options.cropStructure;
     if (!report.cropStructure.empty())
     {
-      const Structure & s = input.GetStructure(report.cropStructure);
+      const Structure & s = NamedStructure(input, report.cropStructure, "preprocess_crop_structure");
       if (s.fixedMask.IsNull() || s.movingMask.IsNull())
         Fail("crop structure '" + s.name + "' needs masks on both images");
       PointType fl, fu, ml, mu;
@@ -498,6 +530,22 @@ Preprocess(const RegistrationProblem & given, const PreprocessOptions & options)
     spacing[d] = options.isotropicSpacing;
     size[d] = std::max<SizeValueType>(1, static_cast<SizeValueType>(std::floor((upper[d] - lower[d]) / spacing[d] + 1e-6)));
     origin[d] = lower[d] + 0.5 * spacing[d];
+  }
+  // A wrong spacing in a header (metres for millimetres, say) makes the grid
+  // astronomically large: refuse it with the figures, not an allocation failure.
+  const double voxels = static_cast<double>(size[0]) * static_cast<double>(size[1]) * static_cast<double>(size[2]);
+  if (voxels > MaximumGridVoxels)
+  {
+    char text[512];
+    std::snprintf(text, sizeof text,
+                  "the preprocessed grid would hold %.3g voxels (%.4g x %.4g x %.4g mm at %g mm); check the images' "
+                  "spacing (fixed %g x %g x %g mm, moving %g x %g x %g mm), or raise preprocess_isotropic_spacing or "
+                  "crop with preprocess_crop_structure",
+                  voxels, upper[0] - lower[0], upper[1] - lower[1], upper[2] - lower[2], options.isotropicSpacing,
+                  input.fixedImage->GetSpacing()[0], input.fixedImage->GetSpacing()[1],
+                  input.fixedImage->GetSpacing()[2], input.movingImage->GetSpacing()[0],
+                  input.movingImage->GetSpacing()[1], input.movingImage->GetSpacing()[2]);
+    Fail(text);
   }
   grid->SetSpacing(spacing);
   grid->SetOrigin(origin);
