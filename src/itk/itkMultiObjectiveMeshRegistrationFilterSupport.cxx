@@ -237,10 +237,16 @@ RunMultiObjectiveRegistration(const RegistrationProblem & problem, const ::morea
 std::string
 UserMessage(const std::string & description)
 {
-  if (description.rfind("ITK ERROR: ", 0) == 0)
-    if (const auto end = description.find("): "); end != std::string::npos)
-      return description.substr(end + 3);
-  return description;
+  const std::string prefix = "ITK ERROR: ";
+  if (description.rfind(prefix, 0) != 0)
+    return description;
+  const std::string rest = description.substr(prefix.size());
+  // An object's exception adds "ClassName(0x...): "; a generic one adds nothing more.
+  const auto open = rest.find("(0x");
+  const auto end = rest.find("): ");
+  if (open != std::string::npos && end != std::string::npos && open < end && rest.find(' ') > open)
+    return rest.substr(end + 3);
+  return rest;
 }
 
 void

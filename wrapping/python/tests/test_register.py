@@ -103,6 +103,14 @@ def test_errors_are_python_exceptions(phantom):
                        parameters={**TINY, "preprocess_rigid_structure": "none"}, backend="cpu", progress=False)
     with pytest.raises(ValueError, match="empty"):
         morea.register(fixed, moving, points={"rectum": (np.zeros((0, 3)), None)}, progress=False)
+    # A mask on another grid than its image, and a guidance structure that is not given.
+    small = sitk.Image([5, 5, 5], sitk.sitkUInt8)
+    with pytest.raises(RuntimeError, match="^structure 'bladder': the fixed mask is not on the image grid"):
+        morea.register(fixed, moving, structures={"bladder": (small, phantom["masks"]["bladder"][1])},
+                       parameters=TINY, backend="cpu", progress=False)
+    with pytest.raises(RuntimeError, match="liver"):
+        morea.register(fixed, moving, structures=phantom["masks"], backend="cpu", progress=False,
+                       parameters={**TINY, "problem_guidance_selection": "liver"})
 
 
 def test_a_callback_that_raises_stops_the_run_after_its_generation(phantom):
