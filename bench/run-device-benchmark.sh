@@ -116,7 +116,7 @@ case "${1:-}" in
         -I "$cuda/extras/CUPTI/include" "$cupti"
       libs+=(--lib "$stage/device-timeline.so" --lib "$cupti")
     fi
-    scripts/device-bundle.sh --data "$stage/abdomen" "${libs[@]}" \
+    tools/device-bundle.sh --data "$stage/abdomen" "${libs[@]}" \
       build/bin/morea build/test/MOREACoreTests "${@:2}"
     ;;
   run)

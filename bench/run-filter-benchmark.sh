@@ -41,7 +41,7 @@ case "${1:-}" in
     # The same phantom and grid with 2 of its structures guiding.
     { cat bench/configurations/phantom6_paper.toml; echo 'problem_guidance_selection = "bladder, rectum"'; } \
       >"$stage/phantom2_paper.toml"
-    scripts/device-bundle.sh --data "$a" --data "$stage/phantom6" --data "$stage/abdomen_paper.toml" \
+    tools/device-bundle.sh --data "$a" --data "$stage/phantom6" --data "$stage/abdomen_paper.toml" \
       --data "$stage/phantom6_paper.toml" --data "$stage/phantom2_paper.toml" \
       build/bin/morea build/bin/RegisterPelvisPhantom build/test/MOREAITKTests build/test/MOREACoreTests
     ;;

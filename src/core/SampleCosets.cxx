@@ -10,7 +10,7 @@ namespace morea
 {
 namespace
 {
-/** W's basis for each block size, as index offsets (scripts/sobol-warp-cosets.py:
+/** W's basis for each block size, as index offsets (tools/cosets/sobol-warp-cosets.py:
  *  for 2^9 grown from the closest offsets; for larger blocks (--bits B) the
  *  elementary box shape, of all whose top-bit counts lie within 2 of each
  *  other, whose cosets touch the fewest 4 x 4 x 2-texel blocks in a

@@ -18,7 +18,7 @@ box; the bits' total is B - 5): it tries every shape whose a_d lie within 2 of
 each other, in a tetrahedron of 1.5 x 2^B voxels, and prints the best three
 with the counts for consecutive lanes and for the 2^9 W in each aligned 512.
 
-Usage: scripts/sobol-warp-cosets.py [--bits B]  (needs numpy; seconds to a minute)
+Usage: tools/cosets/sobol-warp-cosets.py [--bits B]  (needs numpy; seconds to a minute)
 """
 import itertools
 import sys

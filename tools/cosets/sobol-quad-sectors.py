@@ -6,9 +6,9 @@ with the best choice of the two basis vectors of W that span a quad.
 Sectors are modelled for the slice-pair intensity texels (4 bytes; a 32-byte
 sector of 8 x 1 or 4 x 2 texels of one layer); a sample reads the 2 x 2
 texels around it in layer floor(z + 1/2). Points come from
-scripts/sobol-warp-cosets.py (the same tetrahedra and shifts).
+tools/cosets/sobol-warp-cosets.py (the same tetrahedra and shifts).
 
-Usage: scripts/sobol-quad-sectors.py  (needs numpy; about a minute)
+Usage: tools/cosets/sobol-quad-sectors.py  (needs numpy; about a minute)
 """
 import importlib.util
 import itertools
