@@ -12,6 +12,7 @@
 #include "itkMeshTransforms.h"
 #include "itkRegistrationProblem.h"
 #include "morea/MeshGenerator.h"
+#include "morea/MeshRefinement.h"
 #include "morea/ParallelStructure.h"
 #include "morea/RigidityTerm.h"
 
@@ -66,10 +67,19 @@ GuidanceStructureNames(const RegistrationProblem & problem, const ::morea::Param
 MeshModel
 BuildMeshModel(const RegistrationProblem & problem, const ::morea::ParameterSet & parameters);
 
+/** The next mesh level: `coarse`'s base mesh bisected to `targetPoints`
+ *  points where `density` (per coarse tetrahedron, morea::RefinementDensity)
+ *  is highest, with its topology, parallel structure, elasticity and
+ *  rigidity derived afresh from the problem's masks; `refinement` receives
+ *  what carries solutions over (morea::CarryOver). */
+MeshModel
+RefineMeshModel(const MeshModel & coarse, const RegistrationProblem & problem, const ::morea::ParameterSet & parameters,
+                const std::vector<double> & density, std::size_t targetPoints, ::morea::MeshRefinement & refinement);
+
 /** Writes both meshes of `solution` as .vtu files in physical space with cell
  *  data "elasticity", "rigidity" (the rigidity term's weight, 0 outside
  *  rigid structures) and "signed_volume" and point data "origin" (corner,
- *  face, random, contour, surface, Steiner, refinement as 0..6) and "structure". */
+ *  face, random, contour, surface, Steiner, refinement, midpoint as 0..7) and "structure". */
 void
 WriteSolutionMeshes(const MeshModel & model, const ::morea::DualMesh & solution, const std::string & movingPath,
                     const std::string & fixedPath);

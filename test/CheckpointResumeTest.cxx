@@ -5,6 +5,7 @@
 #include "itkPhantomImages.h"
 #include "itkPreprocessing.h"
 #include "morea/Error.h"
+#include "morea/FoldConstraint.h"
 #include "morea/ParameterSet.h"
 
 #include <gtest/gtest.h>
@@ -42,7 +43,11 @@ struct SmallRun
     checkpoint = std::string(MOREA_TEST_OUTPUT_DIR) + "/resume_checkpoint.bin";
     std::filesystem::remove(checkpoint);
   }
-  ~SmallRun() { std::filesystem::remove(checkpoint); }
+  ~SmallRun()
+  {
+    std::filesystem::remove(checkpoint);
+    std::filesystem::remove(checkpoint + ".level0");
+  }
 
   MeshRegistrationResult
   Run(const ::morea::ParameterSet & p, const RegistrationProblem & on) const
@@ -114,5 +119,57 @@ TEST(CheckpointResume, OtherParametersOrImagesAreRefusedNamingTheKey)
   const auto resumed = run.Run(longer, run.problem);
   EXPECT_EQ(resumed.resumedAtGeneration, 2u);
   EXPECT_EQ(resumed.history.size(), 4u);
+}
+
+TEST(CheckpointResume, MultiLevelRunsRefineCarryOverAndResumeAcrossLevels)
+{
+  SmallRun              run;
+  ::morea::ParameterSet p = run.parameters;
+  p.SetFromString("ea_num_generations", "4");
+  p.SetFromString("morea_max_num_mesh_levels", "2");
+  p.SetFromString("morea_num_generations_per_level", "2");
+  p.SetFromString("morea_mesh_refinement_factor", "2");
+  MeshRegistrationOptions plain;
+  plain.backend = ::morea::BackendChoice::Cpu;
+  plain.threads = 2;
+  const MeshRegistrationResult whole = RegisterMeshes(run.problem, p, plain);
+  const auto &                 mesh = whole.model.base;
+  const auto midpoints = std::count(mesh.origins.begin(), mesh.origins.end(), ::morea::PointOrigin::Midpoint);
+  EXPECT_EQ(2 * (mesh.NumberOfPoints() - static_cast<std::size_t>(midpoints)), mesh.NumberOfPoints());
+  ASSERT_EQ(whole.history.size(), 5u); // generations 0 to 4, once each
+  for (std::size_t g = 0; g < whole.history.size(); ++g)
+    EXPECT_EQ(whole.history[g].generation, g);
+  const ::morea::FoldConstraint constraint(whole.model.topology, mesh.points);
+  ASSERT_FALSE(whole.front.empty());
+  for (const auto & s : whole.front)
+  {
+    EXPECT_EQ(s.mesh.source.size(), mesh.NumberOfPoints());
+    EXPECT_TRUE(constraint.Evaluate(s.mesh).Feasible());
+  }
+
+  // Stopped in the second level, then resumed: level 0 from its own file,
+  // the refinement again, level 1 from the run's checkpoint; the same front.
+  MeshRegistrationOptions options = plain;
+  options.checkpointPath = run.checkpoint;
+  options.checkpointInterval = 1;
+  options.resume = true;
+  options.onGeneration = [](const ::morea::GenerationRecord & record, std::size_t total) {
+    EXPECT_EQ(total, 4u);
+    if (record.generation == 3)
+      throw std::runtime_error("stopped");
+  };
+  EXPECT_THROW(RegisterMeshes(run.problem, p, options), std::runtime_error);
+  EXPECT_TRUE(std::filesystem::exists(run.checkpoint + ".level0"));
+  EXPECT_TRUE(std::filesystem::exists(run.checkpoint));
+  options.onGeneration = {};
+  const MeshRegistrationResult resumed = RegisterMeshes(run.problem, p, options);
+  EXPECT_EQ(resumed.resumedAtGeneration, 3u);
+  EXPECT_EQ(resumed.model.base.points, mesh.points);
+  ASSERT_EQ(resumed.front.size(), whole.front.size());
+  for (std::size_t i = 0; i < whole.front.size(); ++i)
+  {
+    EXPECT_EQ(resumed.front[i].fitness.objectives, whole.front[i].fitness.objectives);
+    EXPECT_EQ(resumed.front[i].mesh.target, whole.front[i].mesh.target);
+  }
 }
 } // namespace

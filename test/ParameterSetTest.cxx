@@ -353,7 +353,7 @@ TEST(ParameterSet, OutOfRangeValuesAreErrors)
   EXPECT_CONTAINS(message, "'ea_population_size'");
   EXPECT_CONTAINS(message, "[2, ");
   EXPECT_THROW(ParameterSet::FromToml("ea_adaptive_steering_guidance_threshold = 0.99\n"), Error);
-  EXPECT_THROW(ParameterSet::FromToml("morea_max_num_mesh_levels = 2\n"), Error);
+  EXPECT_THROW(ParameterSet::FromToml("morea_max_num_mesh_levels = 7\n"), Error);
   EXPECT_THROW(ParameterSet::FromToml("seed = -1\n"), Error);
   EXPECT_THROW(ParameterSet::FromToml("seed = 3000000000\n"), Error);
   EXPECT_THROW(ParameterSet::FromToml("morea_sampling_rate = nan\n"), Error);

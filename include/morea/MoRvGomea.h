@@ -49,7 +49,11 @@ struct GomeaOptions
   std::size_t   populationSize{ 700 };
   std::size_t   numberOfClusters{ 10 };
   std::size_t   archiveCapacity{ 2000 };
-  std::size_t   generations{ 500 };
+  std::size_t   generations{ 500 }; ///< the generation the run (or this mesh level) ends at
+  /** The generation this optimiser starts at: 0, or where a mesh level
+   *  begins, so that a multi-level run numbers its generations (and seeds
+   *  their random streams, starts steering) as one run. */
+  std::size_t   firstGeneration{ 0 };
   double        selectionFraction{ 0.35 }; ///< tau
   bool          steeringEnabled{ true };
   std::size_t   steeringStart{ 100 };
@@ -170,9 +174,11 @@ public:
   MemoryFor(const RunShape & shape);
 
   /** Evaluates `population` (size populationSize; folded solutions are
-   *  repaired first) and seeds the archive. */
+   *  repaired first) and seeds the archive with it and with `archived`
+   *  (e.g. a coarser mesh level's archive carried over; folded ones are
+   *  left out). */
   void
-  Initialize(std::vector<DualMesh> population);
+  Initialize(std::vector<DualMesh> population, const std::vector<DualMesh> & archived = {});
 
   /** One generation; throws when called after the last. */
   void

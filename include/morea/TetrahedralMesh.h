@@ -68,7 +68,8 @@ enum class PointOrigin : std::int8_t
   Contour,   ///< a spread-out contour point of a structure
   Surface,   ///< a vertex of a constraining structure surface
   Steiner,   ///< added by the tetrahedraliser to recover a surface
-  Refinement ///< at the circumcentre of a poorly shaped tetrahedron (removes slivers)
+  Refinement, ///< at the circumcentre of a poorly shaped tetrahedron (removes slivers)
+  Midpoint    ///< of an edge bisected between mesh resolution levels (MeshRefinement.h)
 };
 
 /** The base mesh: one configuration of points plus topology and boundary pins. */

@@ -52,6 +52,9 @@ GomeaOptions::Check() const
                 " clusters, or a larger population (the paper: 10 clusters of 700 solutions)");
   if (!(selectionFraction > 0.0 && selectionFraction <= 1.0))
     throw Error("optimiser: the selection fraction must be in (0, 1]");
+  if (firstGeneration >= generations)
+    throw Error("optimiser: a run from generation " + std::to_string(firstGeneration) + " to " +
+                std::to_string(generations) + " has no generation to run");
 }
 
 MoRvGomea::MoRvGomea(const TetrahedralMesh & base, const MeshTopology & topology, const ParallelStructure & parallel,
@@ -184,7 +187,7 @@ MoRvGomea::RenewKeySalt()
 }
 
 void
-MoRvGomea::Initialize(std::vector<DualMesh> population)
+MoRvGomea::Initialize(std::vector<DualMesh> population, const std::vector<DualMesh> & archived)
 {
   if (population.size() != m_Options.populationSize)
     throw Error("optimiser: expected " + std::to_string(m_Options.populationSize) + " initial solutions, got " +
@@ -205,7 +208,7 @@ MoRvGomea::Initialize(std::vector<DualMesh> population)
   m_Totals.assign(m_Population.size(), ObjectiveTotals{});
   m_TetValues.assign(m_Population.size(), {});
   m_NoImprovement.assign(m_Population.size(), 0);
-  m_Generation = 0;
+  m_Generation = m_Options.firstGeneration;
   m_History.clear();
   m_ClusterMeans.clear();
   m_Distributions.clear();
@@ -227,7 +230,35 @@ MoRvGomea::Initialize(std::vector<DualMesh> population)
   }
   for (std::size_t m = 0; m < NumberOfObjectives; ++m)
     m_Reference[m] = worst[m] > 0.0 ? 1.1 * worst[m] : 1.0;
-  m_History.push_back(Summarise(0, GenerationRecord{}));
+  // In batches: the per-tetrahedron values of a whole carried archive on a
+  // fine mesh would take gigabytes at once.
+  constexpr std::size_t batch = 256;
+  for (std::size_t begin = 0; begin < archived.size(); begin += batch)
+  {
+    const std::size_t                             end = std::min(archived.size(), begin + batch);
+    std::vector<const DualMesh *>                 solutions;
+    std::vector<std::vector<TetrahedronValues>>   values(end - begin);
+    std::vector<std::vector<TetrahedronValues> *> outputs;
+    for (std::size_t a = begin; a < end; ++a)
+    {
+      if (archived[a].source.size() != m_Topology.NumberOfPoints() ||
+          archived[a].target.size() != m_Topology.NumberOfPoints())
+        throw Error("optimiser: an archived solution does not match the mesh");
+      solutions.push_back(&archived[a]);
+      outputs.push_back(&values[a - begin]);
+    }
+    m_Backend.EvaluateSolutions(solutions, outputs);
+    for (std::size_t a = begin; a < end; ++a)
+    {
+      ObjectiveTotals totals;
+      for (const auto & v : values[a - begin])
+        totals.Add(v);
+      const Fitness f = totals.ToFitness(m_Topology.NumberOfTetrahedra());
+      if (f.feasible)
+        m_Archive->Insert(f, archived[a], m_NextId++);
+    }
+  }
+  m_History.push_back(Summarise(m_Generation, GenerationRecord{}));
 }
 
 GenerationRecord

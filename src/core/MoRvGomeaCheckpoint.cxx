@@ -403,15 +403,20 @@ MoRvGomea::LoadBytes(const std::string & bytes)
                   " clusters");
   for (auto & m : clusterMeans)
     m = r.Get<ObjectiveVector>();
+  // The history starts at this optimiser's first generation (a mesh level's).
+  const std::size_t first = m_Options.firstGeneration;
+  if (generation < first)
+    throw corrupt("generation " + std::to_string(generation) + ", before this mesh level's first, " +
+                  std::to_string(first));
   std::vector<GenerationRecord> history(r.GetSize(big));
-  if (history.size() != generation + 1)
+  if (history.size() != generation - first + 1)
     throw corrupt("a history of " + std::to_string(history.size()) + " generations at generation " +
                   std::to_string(generation));
   for (std::size_t g = 0; g < history.size(); ++g)
   {
     history[g] = r.Get<GenerationRecord>();
-    if (history[g].generation != g)
-      throw corrupt("generation " + std::to_string(g) + " of the history says it is generation " +
+    if (history[g].generation != first + g)
+      throw corrupt("generation " + std::to_string(first + g) + " of the history says it is generation " +
                     std::to_string(history[g].generation));
   }
   if (!r.AtEnd())

@@ -3,6 +3,7 @@
 #include "itkMOREAImageIO.h"
 #include "itkPreprocessing.h"
 #include "morea/ElasticityFactors.h"
+#include "morea/MeshRefinement.h"
 #include "morea/Error.h"
 #include "morea/ParameterSet.h"
 #include "morea/RigidityTerm.h"
@@ -56,6 +57,54 @@ RigidStructureNames(const RegistrationProblem & problem, const ::morea::Paramete
       notes.push_back("no mask for rigid structure " + name + "; not rigid");
   }
   return names;
+}
+/** What follows from the base mesh: topology, parallel structure,
+ *  elasticity factors and the rigidity model. */
+void
+DeriveMeshModelParts(const RegistrationProblem & problem, const ::morea::ParameterSet & parameters, MeshModel & model)
+{
+  auto start = Clock::now();
+  model.topology = ::morea::MeshTopology(model.base.tetrahedra, model.base.NumberOfPoints());
+  model.parallel = ::morea::BuildParallelStructure(model.topology);
+  model.report.fosElements = model.parallel.elements.size();
+  model.report.parallelGroups = model.parallel.groups.size();
+  model.report.secondsParallelStructure = SecondsSince(start);
+
+  // Elasticity from all structures with a factor, guidance or not (bones, say).
+  start = Clock::now();
+  std::vector<::morea::ElasticStructure>     elastic;
+  std::vector<::morea::Volume<std::uint8_t>> elasticMasks;
+  const auto factors = ::morea::ParseElasticityFactors(parameters.GetString("morea_elasticity_factors"));
+  if (parameters.GetString("morea_magnitude_metric") == "biomechanical")
+  {
+    elasticMasks.reserve(factors.size());
+    for (const auto & [name, factor] : factors)
+    {
+      const Structure * s = problem.FindStructure(name);
+      if (!s || !s->movingMask)
+      {
+        model.report.notes.push_back("no mask for elasticity structure " + name + "; factor 1 there");
+        continue;
+      }
+      elasticMasks.push_back(ToVolume(s->movingMask.GetPointer(), model.frame));
+      elastic.push_back({ name, &elasticMasks.back(), factor });
+    }
+  }
+  model.elasticity = ::morea::ComputeElasticityFactors(model.base, elastic);
+
+  // Rigid structures, guidance or not: the tetrahedra inside their masks.
+  std::vector<::morea::Volume<std::uint8_t>>         rigidMasks;
+  std::vector<const ::morea::Volume<std::uint8_t> *> rigidMaskPointers;
+  rigidMasks.reserve(model.rigidStructureNames.size());
+  for (const std::string & name : model.rigidStructureNames)
+  {
+    rigidMasks.push_back(ToVolume(problem.GetStructure(name).movingMask.GetPointer(), model.frame));
+    rigidMaskPointers.push_back(&rigidMasks.back());
+  }
+  if (!rigidMaskPointers.empty())
+    model.rigidity = ::morea::BuildRigidityModel(model.base, ::morea::UnionOverlapFractions(model.base, rigidMaskPointers),
+                                                 parameters.GetReal("morea_rigid_weight"));
+  model.report.secondsElasticity = SecondsSince(start);
 }
 } // namespace
 
@@ -137,48 +186,42 @@ BuildMeshModel(const RegistrationProblem & problem, const ::morea::ParameterSet 
     model.report.notes = model.report.generation.notes;
     model.report.notes.insert(model.report.notes.end(), rigidNotes.begin(), rigidNotes.end());
 
-    start = Clock::now();
-    model.topology = ::morea::MeshTopology(model.base.tetrahedra, model.base.NumberOfPoints());
-    model.parallel = ::morea::BuildParallelStructure(model.topology);
-    model.report.fosElements = model.parallel.elements.size();
-    model.report.parallelGroups = model.parallel.groups.size();
-    model.report.secondsParallelStructure = SecondsSince(start);
+    DeriveMeshModelParts(problem, parameters, model);
+  }
+  catch (const ::morea::Error & e)
+  {
+    itkGenericExceptionMacro("mesh model: " << e.what());
+  }
+  return model;
+}
 
-    // Elasticity from all structures with a factor, guidance or not (bones, say).
-    start = Clock::now();
-    std::vector<::morea::ElasticStructure>     elastic;
-    std::vector<::morea::Volume<std::uint8_t>> elasticMasks;
-    const auto factors = ::morea::ParseElasticityFactors(parameters.GetString("morea_elasticity_factors"));
-    if (parameters.GetString("morea_magnitude_metric") == "biomechanical")
+MeshModel
+RefineMeshModel(const MeshModel & coarse, const RegistrationProblem & problem, const ::morea::ParameterSet & parameters,
+                const std::vector<double> & density, std::size_t targetPoints, ::morea::MeshRefinement & refinement)
+{
+  MeshModel model;
+  model.frame = coarse.frame;
+  model.rigidStructureNames = coarse.rigidStructureNames;
+  model.structureNames = coarse.structureNames;
+  try
+  {
+    refinement = ::morea::RefineMesh(coarse.base, density, targetPoints);
+    model.base = refinement.mesh;
+    model.report.generation = coarse.report.generation;
+    model.report.notes = coarse.report.notes;
+    model.report.generation.tetrahedra = model.base.NumberOfTetrahedra();
+    model.report.generation.worstQuality = 1.0;
+    model.report.generation.slivers = 0;
+    for (const auto & t : model.base.tetrahedra)
     {
-      elasticMasks.reserve(factors.size());
-      for (const auto & [name, factor] : factors)
-      {
-        const Structure * s = problem.FindStructure(name);
-        if (!s || !s->movingMask)
-        {
-          model.report.notes.push_back("no mask for elasticity structure " + name + "; factor 1 there");
-          continue;
-        }
-        elasticMasks.push_back(ToVolume(s->movingMask.GetPointer(), model.frame));
-        elastic.push_back({ name, &elasticMasks.back(), factor });
-      }
+      const double q = ::morea::TetrahedronQuality(model.base.points[t[0]], model.base.points[t[1]],
+                                                   model.base.points[t[2]], model.base.points[t[3]]);
+      model.report.generation.worstQuality = std::min(model.report.generation.worstQuality, q);
+      model.report.generation.slivers += q < 0.05 ? 1 : 0;
     }
-    model.elasticity = ::morea::ComputeElasticityFactors(model.base, elastic);
-
-    // Rigid structures, guidance or not: the tetrahedra inside their masks.
-    std::vector<::morea::Volume<std::uint8_t>>         rigidMasks;
-    std::vector<const ::morea::Volume<std::uint8_t> *> rigidMaskPointers;
-    rigidMasks.reserve(model.rigidStructureNames.size());
-    for (const std::string & name : model.rigidStructureNames)
-    {
-      rigidMasks.push_back(ToVolume(problem.GetStructure(name).movingMask.GetPointer(), model.frame));
-      rigidMaskPointers.push_back(&rigidMasks.back());
-    }
-    if (!rigidMaskPointers.empty())
-      model.rigidity = ::morea::BuildRigidityModel(model.base, ::morea::UnionOverlapFractions(model.base, rigidMaskPointers),
-                                                   parameters.GetReal("morea_rigid_weight"));
-    model.report.secondsElasticity = SecondsSince(start);
+    model.report.notes.push_back("mesh refined from " + std::to_string(coarse.base.NumberOfPoints()) + " to " +
+                                 std::to_string(model.base.NumberOfPoints()) + " points");
+    DeriveMeshModelParts(problem, parameters, model);
   }
   catch (const ::morea::Error & e)
   {

@@ -7,6 +7,7 @@
 #include "morea/FoldConstraint.h"
 #include "morea/InitialPopulation.h"
 #include "morea/MemoryEstimate.h"
+#include "morea/MeshRefinement.h"
 #include "morea/ParameterSet.h"
 #include "morea/TetrahedronObjectives.h"
 
@@ -14,6 +15,7 @@
 #include <chrono>
 #include <filesystem>
 #include <future>
+#include <optional>
 #include <string>
 #include <thread>
 #include <utility>
@@ -90,6 +92,44 @@ RunFingerprintOf(const RegistrationProblem & problem, const ::morea::ParameterSe
   return fingerprint;
 }
 
+namespace
+{
+/** Level `level`'s checkpoint file: the run's own for the last level (or
+ *  the only one), beside it with ".levelK" for earlier ones. */
+std::string
+LevelCheckpointPath(const std::string & path, std::size_t level, const ::morea::MeshLevelPlan & plan)
+{
+  if (path.empty() || level + 1 == plan.levels)
+    return path;
+  return path + ".level" + std::to_string(level);
+}
+
+/** Per coarse tetrahedron, where the next level needs points: from up to 16
+ *  archived solutions spread along the front (by guidance). */
+std::vector<double>
+NextLevelDensity(const MeshModel & model, const ::morea::ElitistArchive & archive, ::morea::EvaluationBackend & backend)
+{
+  std::vector<const ::morea::ArchiveEntry *> entries;
+  for (const auto & e : archive.Entries())
+    entries.push_back(&e);
+  std::stable_sort(entries.begin(), entries.end(), [](const auto * a, const auto * b) {
+    return a->fitness.objectives[2] < b->fitness.objectives[2];
+  });
+  const std::size_t                                    count = std::min<std::size_t>(16, entries.size());
+  std::vector<const ::morea::DualMesh *>               solutions;
+  std::vector<std::vector<::morea::TetrahedronValues>> values(count);
+  std::vector<std::vector<::morea::TetrahedronValues> *> outputs;
+  for (std::size_t i = 0; i < count; ++i)
+  {
+    solutions.push_back(&entries[i * entries.size() / count]->solution);
+    outputs.push_back(&values[i]);
+  }
+  if (count > 0)
+    backend.EvaluateSolutions(solutions, outputs);
+  return ::morea::RefinementDensity(model.base, values);
+}
+} // namespace
+
 MeshRegistrationResult
 RegisterMeshes(const RegistrationProblem & problem, const ::morea::ParameterSet & parameters,
                const MeshRegistrationOptions & options)
@@ -103,6 +143,7 @@ RegisterMeshes(const RegistrationProblem & problem, const ::morea::ParameterSet 
     return seconds;
   };
   MeshRegistrationResult result;
+  const ::morea::MeshLevelPlan plan = ::morea::MeshLevelPlan::FromParameters(parameters);
   // The objective data (distance maps) need the model's frame only: they are
   // made while the mesh is built (TetGen runs on one core). Without a moving
   // image there is no frame, and BuildMeshModel reports the missing images.
@@ -111,67 +152,126 @@ RegisterMeshes(const RegistrationProblem & problem, const ::morea::ParameterSet 
     objectiveData = std::async(std::launch::async, [&problem, &parameters] {
       return BuildObjectiveData(problem, DomainFrame::Of(problem.movingImage), parameters);
     });
-  result.model = BuildMeshModel(problem, parameters);
-  const MeshModel & model = result.model;
+  MeshModel model = BuildMeshModel(problem, parameters);
   result.secondsMesh = lap();
   const ::morea::ObjectiveData data = objectiveData.get();
   result.secondsObjectiveData = lap(); // what the mesh did not hide
-  const ::morea::FoldConstraint constraint(model.topology, model.base.points,
-                                                parameters.GetReal("morea_fold_volume_fraction"));
-  const ::morea::TetrahedronEvaluator evaluator(model.topology, constraint, model.elasticity, model.rigidity, data);
+  const std::size_t coarsePoints = model.base.NumberOfPoints();
+
   ::morea::BackendRequest request;
   request.choice = options.backend;
   request.device = options.device;
   request.minimumComputeLevel = options.minimumComputeLevel;
   request.threads = options.threads;
-  auto backend = ::morea::CreateEvaluationBackend(request, evaluator, &result.backendNote);
-  result.backend = backend->Name();
-  result.pathNote = backend->PathNote();
   result.threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
-  result.secondsBackend = lap();
-  result.secondsModel = result.secondsMesh + result.secondsObjectiveData + result.secondsBackend;
 
-  start = Clock::now();
-  ::morea::GomeaOptions gomea = ::morea::GomeaOptions::FromParameters(parameters);
-  gomea.boundRefusals = ::morea::UsesRefusalBounds(options.refusalBounds, *backend);
-  gomea.threads = options.threads; // the backend's pool: the two take turns on it
+  ::morea::GomeaOptions baseOptions = ::morea::GomeaOptions::FromParameters(parameters);
+  baseOptions.threads = options.threads; // the backend's pool: the two take turns on it
   // What a checkpoint belongs to: the caller's entries, then the problem's.
-  gomea.fingerprint = options.fingerprint;
+  baseOptions.fingerprint = options.fingerprint;
   const ::morea::RunFingerprint ofProblem = RunFingerprintOf(problem, parameters);
   for (const auto & [key, value] : ofProblem.Entries())
-    gomea.fingerprint.Add(key, value);
-  gomea.fingerprint.AddEvaluationBackend(result.backend);
-  ::morea::RunShape shape = ::morea::RunShapeOf(gomea, model.topology, model.parallel);
-  shape.checkpoints = !options.checkpointPath.empty();
-  ::morea::CheckRunMemory(shape, *backend); // before the population exists, not as bad_alloc midway
-  ::morea::MoRvGomea optimiser(model.base, model.topology, model.parallel, constraint, *backend, gomea);
+    baseOptions.fingerprint.Add(key, value);
+
   ::morea::CheckpointWriter checkpoints; // files written while the next generations run
   std::size_t               checkpointGeneration = 0; // of the last checkpoint written; 0: none
+  std::string               checkpointPath = options.checkpointPath;
+  std::size_t               generation = 0;
+  // Each level's solutions carried over to the next (refined) mesh.
+  std::vector<::morea::DualMesh> carriedPopulation, carriedArchive;
+  std::optional<MeshModel>       refined;
+  double                         secondsLevels = 0.0;
   try
   {
-    if (options.resume && !options.checkpointPath.empty() && std::filesystem::exists(options.checkpointPath))
+    for (std::size_t level = 0; level < plan.levels; ++level)
     {
-      optimiser.LoadCheckpoint(options.checkpointPath);
-      result.resumedAtGeneration = checkpointGeneration = optimiser.Generation();
-    }
-    else
-      optimiser.Initialize(::morea::GenerateInitialPopulation(
-        model.base, constraint, gomea.populationSize, gomea.seed,
-        ::morea::InitialPopulationOptions::FromParameters(parameters)));
-    while (!optimiser.Finished())
-    {
-      optimiser.RunGeneration();
-      const bool last = optimiser.Finished();
-      if (!options.checkpointPath.empty() &&
-          (last || (options.checkpointInterval > 0 && optimiser.Generation() % options.checkpointInterval == 0)))
+      if (refined)
       {
-        std::string bytes = checkpoints.TakeBuffer(); // the last checkpoint's room
-        optimiser.CheckpointBytes(bytes);
-        checkpoints.Write(std::move(bytes), options.checkpointPath);
+        model = std::move(*refined);
+        refined.reset();
+      }
+      const ::morea::FoldConstraint constraint(model.topology, model.base.points,
+                                               parameters.GetReal("morea_fold_volume_fraction"));
+      const ::morea::TetrahedronEvaluator evaluator(model.topology, constraint, model.elasticity, model.rigidity, data);
+      auto backend = ::morea::CreateEvaluationBackend(request, evaluator, level == 0 ? &result.backendNote : nullptr);
+      if (level == 0)
+      {
+        result.backend = backend->Name();
+        result.pathNote = backend->PathNote();
+        result.secondsBackend = lap();
+        result.secondsModel = result.secondsMesh + result.secondsObjectiveData + result.secondsBackend;
+      }
+      start = Clock::now();
+
+      ::morea::GomeaOptions gomea = baseOptions;
+      gomea.boundRefusals = ::morea::UsesRefusalBounds(options.refusalBounds, *backend);
+      gomea.firstGeneration = plan.FirstGeneration(level);
+      gomea.generations = plan.EndGeneration(level);
+      gomea.fingerprint.AddEvaluationBackend(result.backend);
+      if (plan.levels > 1)
+        gomea.fingerprint.Add("mesh level", std::to_string(level) + " of " + std::to_string(plan.levels));
+      ::morea::RunShape shape = ::morea::RunShapeOf(gomea, model.topology, model.parallel);
+      shape.checkpoints = !options.checkpointPath.empty();
+      ::morea::CheckRunMemory(shape, *backend); // before the population exists, not as bad_alloc midway
+      ::morea::MoRvGomea optimiser(model.base, model.topology, model.parallel, constraint, *backend, gomea);
+      checkpointPath = LevelCheckpointPath(options.checkpointPath, level, plan);
+      if (options.resume && !checkpointPath.empty() && std::filesystem::exists(checkpointPath))
+      {
+        optimiser.LoadCheckpoint(checkpointPath);
+        result.resumedAtGeneration = optimiser.Generation(); // the last level loaded says where
         checkpointGeneration = optimiser.Generation();
       }
-      if (options.onGeneration)
-        options.onGeneration(optimiser.History().back(), gomea.generations);
+      else
+      {
+        if (level == 0)
+          optimiser.Initialize(::morea::GenerateInitialPopulation(
+            model.base, constraint, gomea.populationSize, gomea.seed,
+            ::morea::InitialPopulationOptions::FromParameters(parameters)));
+        else
+          optimiser.Initialize(std::move(carriedPopulation), carriedArchive);
+        // Later levels' files are another run's now: a resume must not take them.
+        for (std::size_t later = level + 1; later < plan.levels && !options.checkpointPath.empty(); ++later)
+          std::filesystem::remove(LevelCheckpointPath(options.checkpointPath, later, plan));
+      }
+      carriedPopulation.clear();
+      carriedArchive.clear();
+      generation = optimiser.Generation();
+      while (!optimiser.Finished())
+      {
+        optimiser.RunGeneration();
+        generation = optimiser.Generation();
+        const bool last = optimiser.Finished();
+        if (!checkpointPath.empty() &&
+            (last || (options.checkpointInterval > 0 && optimiser.Generation() % options.checkpointInterval == 0)))
+        {
+          std::string bytes = checkpoints.TakeBuffer(); // the last checkpoint's room
+          optimiser.CheckpointBytes(bytes);
+          checkpoints.Write(std::move(bytes), checkpointPath);
+          checkpointGeneration = optimiser.Generation();
+        }
+        if (options.onGeneration)
+          options.onGeneration(optimiser.History().back(), plan.generations);
+      }
+      checkpoints.Wait(); // a level's last checkpoint is whole before the next level starts
+      const auto & history = optimiser.History();
+      // A later level's first record repeats the generation the level before ended at.
+      result.history.insert(result.history.end(), history.begin() + (level > 0 ? 1 : 0), history.end());
+      if (level + 1 < plan.levels)
+      {
+        ::morea::MeshRefinement refinement;
+        refined = RefineMeshModel(model, problem, parameters, NextLevelDensity(model, optimiser.Archive(), *backend),
+                                  plan.PointsAt(level + 1, coarsePoints), refinement);
+        for (const auto & solution : optimiser.Population())
+          carriedPopulation.push_back(::morea::CarryOver(refinement, solution));
+        for (const auto & e : optimiser.Archive().Entries())
+          carriedArchive.push_back(::morea::CarryOver(refinement, e.solution));
+      }
+      else
+      {
+        for (const auto & e : optimiser.Archive().Entries())
+          result.front.push_back({ e.id, e.fitness, e.solution });
+      }
+      secondsLevels += std::chrono::duration<double>(Clock::now() - start).count();
     }
   }
   catch (const ::morea::OutOfDeviceMemory & e)
@@ -179,21 +279,19 @@ RegisterMeshes(const RegistrationProblem & problem, const ::morea::ParameterSet 
     // Another process took the device's memory, or the estimate fell
     // short: say what ran out where, and what is left to resume from.
     checkpoints.Wait();
-    std::string message = std::string(e.what()) + " after " + std::to_string(optimiser.Generation()) +
-                          " generations, with a population of " + std::to_string(gomea.populationSize) +
+    std::string message = std::string(e.what()) + " after " + std::to_string(generation) +
+                          " generations, with a population of " + std::to_string(baseOptions.populationSize) +
                           " (ea_population_size) on a mesh of " + std::to_string(model.base.NumberOfPoints()) +
                           " points: free the device, lower ea_population_size or morea_mesh_num_points, or run "
                           "on the cpu backend";
     if (checkpointGeneration > 0)
-      message += "; the checkpoint " + options.checkpointPath + " (generation " +
-                 std::to_string(checkpointGeneration) + ") resumes on a device with room";
+      message += "; the checkpoint " + checkpointPath + " (generation " + std::to_string(checkpointGeneration) +
+                 ") resumes on a device with room";
     throw ::morea::Error(message);
   }
   checkpoints.Wait();
-  result.secondsOptimisation = std::chrono::duration<double>(Clock::now() - start).count();
-  result.history = optimiser.History();
-  for (const auto & e : optimiser.Archive().Entries())
-    result.front.push_back({ e.id, e.fitness, e.solution });
+  result.model = std::move(model);
+  result.secondsOptimisation = secondsLevels;
   std::stable_sort(result.front.begin(), result.front.end(), [](const FrontSolution & a, const FrontSolution & b) {
     return a.fitness.objectives[2] < b.fitness.objectives[2];
   });
