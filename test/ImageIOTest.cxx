@@ -6,6 +6,7 @@
 #include "itkImageRegionConstIterator.h"
 #include "itkImageRegionIteratorWithIndex.h"
 
+#include "ItkErrorSupport.h"
 #include "TestScratchDir.h"
 
 #include <gtest/gtest.h>
@@ -24,6 +25,8 @@ using namespace itk::morea;
 
 namespace
 {
+using morea_test::ItkError;
+
 fs::path
 ScratchDir()
 {
@@ -39,37 +42,6 @@ Listing(const fs::path & dir)
     names.insert(entry.path().filename().string());
   return names;
 }
-
-/** The message of the itk::ExceptionObject thrown by `f`; fails when none is thrown. */
-template <typename F>
-std::string
-ItkError(F && f)
-{
-  try
-  {
-    f();
-  }
-  catch (const itk::ExceptionObject & e)
-  {
-    return e.GetDescription();
-  }
-  catch (const std::exception & e)
-  {
-    ADD_FAILURE() << "expected itk::ExceptionObject, got: " << e.what();
-    return "";
-  }
-  ADD_FAILURE() << "expected itk::ExceptionObject, nothing was thrown";
-  return "";
-}
-
-::testing::AssertionResult
-Contains(const std::string & haystack, const std::string & needle)
-{
-  if (haystack.find(needle) != std::string::npos)
-    return ::testing::AssertionSuccess();
-  return ::testing::AssertionFailure() << "message '" << haystack << "' does not contain '" << needle << "'";
-}
-#define EXPECT_CONTAINS(haystack, needle) EXPECT_TRUE(Contains((haystack), (needle)))
 
 template <typename TImage>
 void

@@ -9,6 +9,7 @@
 #include "itkImageFileWriter.h"
 #include "itkMetaDataObject.h"
 
+#include "ItkErrorSupport.h"
 #include "TestScratchDir.h"
 
 #include <gtest/gtest.h>
@@ -26,23 +27,7 @@ using namespace itk::morea;
 
 namespace
 {
-/** The message of the itk::ExceptionObject `f` throws; "" when none. */
-template <typename F>
-std::string
-ItkError(F && f)
-{
-  try
-  {
-    f();
-  }
-  catch (const itk::ExceptionObject & e)
-  {
-    return e.GetDescription();
-  }
-  return "";
-}
-
-#define EXPECT_CONTAINS(text, part) EXPECT_NE(std::string(text).find(part), std::string::npos) << (text)
+using morea_test::ItkError;
 
 std::string
 MetaHeader(const std::string & dimSize, bool compressed, long long compressedSize = -1,

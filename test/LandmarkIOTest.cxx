@@ -2,6 +2,7 @@
 #include "itkLandmarkIO.h"
 #include "itkMOREAImageIO.h"
 
+#include "ItkErrorSupport.h"
 #include "TestScratchDir.h"
 
 #include <gtest/gtest.h>
@@ -17,6 +18,8 @@ using namespace itk::morea;
 
 namespace
 {
+using morea_test::ItkError;
+
 fs::path
 ScratchDir()
 {
@@ -30,36 +33,6 @@ WriteText(const fs::path & path, const std::string & text)
   out << text;
   return path.string();
 }
-
-template <typename F>
-std::string
-ItkError(F && f)
-{
-  try
-  {
-    f();
-  }
-  catch (const itk::ExceptionObject & e)
-  {
-    return e.GetDescription();
-  }
-  catch (const std::exception & e)
-  {
-    ADD_FAILURE() << "expected itk::ExceptionObject, got: " << e.what();
-    return "";
-  }
-  ADD_FAILURE() << "expected itk::ExceptionObject, nothing was thrown";
-  return "";
-}
-
-::testing::AssertionResult
-Contains(const std::string & haystack, const std::string & needle)
-{
-  if (haystack.find(needle) != std::string::npos)
-    return ::testing::AssertionSuccess();
-  return ::testing::AssertionFailure() << "message '" << haystack << "' does not contain '" << needle << "'";
-}
-#define EXPECT_CONTAINS(haystack, needle) EXPECT_TRUE(Contains((haystack), (needle)))
 
 PointType
 P(double x, double y, double z)

@@ -7,6 +7,7 @@
 #include "itkRegistrationProblem.h"
 #include "morea/ParameterSet.h"
 
+#include "ItkErrorSupport.h"
 #include "TestScratchDir.h"
 
 #include <gtest/gtest.h>
@@ -19,22 +20,7 @@ using namespace itk::morea;
 
 namespace
 {
-template <typename F>
-std::string
-ItkError(F && f)
-{
-  try
-  {
-    f();
-  }
-  catch (const itk::ExceptionObject & e)
-  {
-    return e.GetDescription();
-  }
-  return "";
-}
-
-#define EXPECT_CONTAINS(text, part) EXPECT_NE(std::string(text).find(part), std::string::npos) << (text)
+using morea_test::ItkError;
 
 /** A 30^3 grid of 1 mm with a box of voxels [from, to) set. */
 template <typename TImage>
