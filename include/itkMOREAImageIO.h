@@ -5,6 +5,7 @@
 #define itkMOREAImageIO_h
 
 #include "itkMOREATypes.h"
+#include "itkTransformBase.h"
 
 #include <map>
 #include <string>
@@ -75,6 +76,11 @@ WriteTextFile(const std::string & text, const std::string & path);
 /** Reads a displacement field (vector image with 3 components, mm). */
 DisplacementFieldType::Pointer
 ReadDisplacementField(const std::string & path);
+
+/** Writes a transform file (.h5, .tfm, .txt: ITK's transform IO picks by
+ *  extension) atomically; the message names `path` when it cannot. */
+void
+WriteTransformFile(const TransformBaseTemplate<double> * transform, const std::string & path);
 
 /** Moves `temporaryPath` onto `finalPath` atomically (same file system). */
 void

@@ -1,5 +1,6 @@
 #include "itkMOREAImageIO.h"
 #include "itkMOREAFail.h"
+#include "itkTransformFileWriter.h"
 
 #include "itkGDCMImageIO.h"
 #include "itkGDCMSeriesFileNames.h"
@@ -400,6 +401,25 @@ TemporaryPathFor(const std::string & finalPath)
   const std::string ext = dot == std::string::npos ? "" : name.substr(dot);
   const std::string tmp = "." + stem + ".tmp" + std::to_string(::getpid()) + "_" + std::to_string(counter++) + ext;
   return (p.parent_path() / tmp).string();
+}
+
+void
+WriteTransformFile(const TransformBaseTemplate<double> * transform, const std::string & path)
+{
+  const std::string tmp = TemporaryPathFor(path);
+  auto              writer = TransformFileWriterTemplate<double>::New();
+  writer->SetInput(transform);
+  writer->SetFileName(tmp);
+  try
+  {
+    writer->Update();
+  }
+  catch (const ExceptionObject & e)
+  {
+    std::remove(tmp.c_str());
+    Fail("cannot write transform '" + path + "': " + e.GetDescription());
+  }
+  CommitFile(tmp, path);
 }
 
 void

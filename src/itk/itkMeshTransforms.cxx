@@ -1,6 +1,5 @@
 #include "itkMeshTransforms.h"
 #include "itkCompositeTransform.h"
-#include "itkTransformFileWriter.h"
 
 #include "itkMOREAImageIO.h"
 #include "itkPhantomImages.h"
@@ -374,20 +373,7 @@ WriteSolutionTransforms(const OriginalFrameTransforms & transforms, const std::s
   for (const auto & [transform, path] : { std::make_pair(transforms.fixedToMoving, fixedToMovingPath),
                                           std::make_pair(transforms.movingToFixed, movingToFixedPath) })
   {
-    const std::string tmp = TemporaryPathFor(path);
-    auto              writer = TransformFileWriterTemplate<double>::New();
-    writer->SetInput(transform);
-    writer->SetFileName(tmp);
-    try
-    {
-      writer->Update();
-    }
-    catch (const ExceptionObject & e)
-    {
-      std::remove(tmp.c_str());
-      itkGenericExceptionMacro("cannot write transform '" << path << "': " << e.GetDescription());
-    }
-    CommitFile(tmp, path);
+    WriteTransformFile(transform, path);
   }
 }
 

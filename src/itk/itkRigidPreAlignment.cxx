@@ -14,7 +14,6 @@
 #include "itkRegularStepGradientDescentOptimizerv4.h"
 #include "itkSignedMaurerDistanceMapImageFilter.h"
 #include "itkMOREAImageIO.h"
-#include "itkTransformFileWriter.h"
 
 #include <algorithm>
 #include <chrono>
@@ -289,20 +288,7 @@ AlignRigidly(const MaskType * fixedMask, const MaskType * movingMask, const Rigi
 void
 WriteRigidTransform(const PreAlignmentTransformType * transform, const std::string & path)
 {
-  const std::string tmp = TemporaryPathFor(path);
-  auto              writer = TransformFileWriterTemplate<double>::New();
-  writer->SetInput(transform);
-  writer->SetFileName(tmp);
-  try
-  {
-    writer->Update();
-  }
-  catch (const ExceptionObject & e)
-  {
-    std::remove(tmp.c_str());
-    Fail("cannot write transform '" + path + "': " + e.GetDescription());
-  }
-  CommitFile(tmp, path);
+  WriteTransformFile(transform, path);
 }
 
 } // namespace morea
