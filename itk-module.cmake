@@ -1,3 +1,5 @@
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 # Remote-module description for an in-ITK build (ITK/Modules/Remote).
 get_filename_component(MY_CURRENT_DIR "${CMAKE_CURRENT_LIST_FILE}" PATH)
 file(READ "${MY_CURRENT_DIR}/README.md" DOCUMENTATION)

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // Times the mesh model's steps at the paper's scale (600 points, population
 // 700) on the phantom: mesh generation, parallel structure, initial
 // population, fold evaluation and rasterisation. A plain timed program: run it

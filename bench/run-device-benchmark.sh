@@ -1,4 +1,6 @@
 #!/usr/bin/env bash
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 # The CUDA benchmark on a GPU machine without ITK (see README.md, "CUDA backend").
 #   Here:          bench/run-device-benchmark.sh bundle [PROGRAM...]
 #                  builds morea and the core tests (CUDA for sm_90), packs them (and

@@ -1,4 +1,6 @@
 #!/usr/bin/env bash
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 # Whole registrations through the ITK filter with default settings, and the
 # same through `morea register`, on a GPU machine without ITK (results:
 # bench/results/filter-benchmark.md).

@@ -1,4 +1,6 @@
 #!/usr/bin/env bash
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 # Multi-resolution meshes against one mesh: the paper's configuration with
 # one mesh level and with three (600 -> ~1400 -> ~3200 points), on the
 # abdominal CBCT pair (stomach and bowel Dice and HD95 of the chosen

@@ -1,4 +1,6 @@
 #!/usr/bin/env bash
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 # Bone landmark TRE with and without bones among the guidance structures,
 # with and without the rigidity term (morea_rigid_weight 0), on a case of the
 # phantom suite whose truth is known (bones do not move in its new cases).

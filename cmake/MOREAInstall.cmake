@@ -1,3 +1,5 @@
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 # `cmake --install`: headers, the static libraries, the `morea` command and a
 # CMake package (find_package(MultiObjectiveRegistration)). The Python
 # package installs only when pip builds it (wrapping/python).

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 /*=========================================================================
  *  Registers a problem folder (such as the pelvis phantom `morea phantom`
  *  writes) with itk::MultiObjectiveMeshRegistrationFilter in a plain ITK

@@ -1,3 +1,5 @@
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 # RegisterPelvisPhantom on the phantom, then `morea register` with the same
 # parameters, seed and backend: the two fronts must be the same, and the
 # bladder's Dice must improve.

@@ -1,4 +1,6 @@
 #!/usr/bin/env bash
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 # Loads the abdominal CBCT pair from its RT Structure Sets (DICOM), preprocesses
 # it around the stomach and prints the baseline scores.
 set -euo pipefail

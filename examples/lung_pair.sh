@@ -1,4 +1,6 @@
 #!/usr/bin/env bash
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 # Preprocesses the lung CT pair (rigid pre-alignment on the lung masks) and
 # scores the result against the 51 expert landmarks.
 set -euo pipefail

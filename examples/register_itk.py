@@ -1,4 +1,6 @@
 #!/usr/bin/env python3
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 """MOREA from itk (PyPI `itk`): the pelvis phantom as itk images registered,
 the best-guidance solution's itk transform applied to the moving image and
 masks with itk's resampler, Dice before and after printed, the transform

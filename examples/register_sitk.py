@@ -1,4 +1,6 @@
 #!/usr/bin/env python3
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 """MOREA from SimpleITK: the pelvis phantom (or a folder written by
 `morea phantom -o FOLDER`) registered, the best-guidance solution applied to
 the moving image and masks, Dice before and after printed, the transform

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 /*=========================================================================
  *  MultiObjectiveRegistration: a registration's results as a folder, the one
  *  layout that `morea register`, the filter's users and Python's

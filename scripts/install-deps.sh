@@ -1,4 +1,6 @@
 #!/usr/bin/env bash
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 # Installs the Debian 12 packages this module builds and tests against.
 # Safe to run repeatedly; needs root (or sudo).
 set -euo pipefail
@@ -18,6 +20,7 @@ packages=(
   elastix                  # comparison study (study/): elastix 5.0.1 and transformix
   python3-venv python3-pip # comparison study and the Python package's tests: packages in a venv
   python3-dev pybind11-dev # the Python package (morea): its extension module
+  chromium chromium-driver # the front navigator's test drives the page in a headless browser
 )
 
 SUDO=""

@@ -1,4 +1,6 @@
 #!/usr/bin/env bash
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 # Installs the dependencies, builds, and runs the default job on the embedded
 # phantom (output in ./demo-out).
 set -euo pipefail

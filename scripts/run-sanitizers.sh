@@ -1,4 +1,6 @@
 #!/usr/bin/env bash
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 # AddressSanitizer and UndefinedBehaviorSanitizer (GCC) over the plain C++
 # layers: the core's and the mesh layer's unit tests, then a small
 # registration through `morea` (phantom, preprocessing, mesh, MO-RV-GOMEA on

@@ -1,4 +1,6 @@
 #!/usr/bin/env bash
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 # Installs the dependencies, builds everything and runs all tests with CTest.
 # Tests on the real patient data in ../shared/data skip themselves when it is absent.
 set -euo pipefail
@@ -14,7 +16,7 @@ venv="$PWD/build/pip-venv"
 rm -rf "$venv"
 /usr/bin/python3 -m venv "$venv"
 "$venv/bin/python" -m pip install -q --disable-pip-version-check ".[itk,test]"
-(cd build && MOREA_BIN="$PWD/bin/morea" "$venv/bin/python" -m pytest -q -p no:cacheprovider \
+(cd build && MOREA_BIN="$PWD/bin/morea" MOREA_REQUIRE_BROWSER=1 "$venv/bin/python" -m pytest -q -p no:cacheprovider \
   -W ignore::DeprecationWarning ../wrapping/python/tests)
 for example in register_sitk register_itk; do
   "$venv/bin/python" "examples/$example.py" --generations 3 --output "build/examples/$example"

@@ -1,3 +1,5 @@
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 """ANTs SyN on a preprocessed problem, with the paper's command (appendix C,
 "multivariate registration with composite masks"), run through antspyx's
 bundled antsRegistration, and conversion of its transforms to the fields

@@ -1,3 +1,5 @@
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 """Shared helpers of the comparison study: the morea binary, subprocesses with
 timing, displacement-field IO and inversion, composite masks.
 

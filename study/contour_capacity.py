@@ -1,3 +1,5 @@
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 """What limits the contour match: the mesh, or the search?
 
 For a solution of `morea register` (its two meshes, `mesh_moving.vtu` and

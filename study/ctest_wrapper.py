@@ -1,3 +1,5 @@
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 """Runs the study's pytest tests or its quick study under CTest; exits 77
 (CTest: skipped) when a package or elastix is missing, so a build without the
 study's dependencies still passes its tests."""

@@ -1,3 +1,5 @@
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 """elastix on a preprocessed problem: the paper's unidirectional B-spline
 registration (study/params/elastix_bspline.txt), preceded by the same
 registration of the composite mask images (appendix C), and conversion of the

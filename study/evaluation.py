@@ -1,3 +1,5 @@
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 """The study's one evaluation pipeline: `morea evaluate` on the study's problem
 folder for every method, and the flattening of its scores.json into table rows."""
 from __future__ import annotations

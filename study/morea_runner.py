@@ -1,3 +1,5 @@
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 """MOREA in the study: `morea register` on the raw problem with a study
 parameter file and a seed. `morea register` preprocesses with the same keys as
 `morea preprocess` did for the study's problem folder, so its fields lie on the

@@ -1,3 +1,5 @@
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 """The registration problems of the study: raw inputs (as `morea` options),
 the MOREA parameter file (whose preprocessing keys define the problem every
 method is scored on) and the most-deforming structure with the scores that

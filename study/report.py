@@ -1,3 +1,5 @@
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 """Tables (CSV, Markdown), Mann-Whitney U tests, plots and renders of a study."""
 from __future__ import annotations
 

@@ -1,3 +1,5 @@
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 """The comparison study on one pair: MOREA against elastix and ANTs SyN.
 
     python3 -m study run --pair lung|abdomen|phantom --out DIR [--quick]

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // Test helper: a box split into a grid of cubes, each cube into six positively
 // oriented tetrahedra (Kuhn/Freudenthal split, so neighbouring cubes' faces
 // match), plus a fold-free random perturbation of its points.

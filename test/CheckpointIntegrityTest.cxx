@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // Checkpoints that cannot lie: a damaged, truncated or edited checkpoint, or
 // one of another run, is refused with a message that says why, and the
 // optimiser is left as it was. One test per kind of corruption; the edits are

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // Resuming RegisterMeshes from its checkpoint: allowed with what it was
 // written with (also for more generations), refused with other objective or
 // preprocessing parameters or other images, naming the first key that differs.

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // PNG contour overlays: size, colours, orientation and failure behaviour.
 #include "itkContourOverlayRenderer.h"
 

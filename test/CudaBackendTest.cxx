@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // The CUDA evaluation backend against the CPU reference (SPEC 6): the same
 // solutions and the same partial candidates give the same per-tetrahedron
 // values (sample counts and folds exactly, objectives to relative 1e-4), and
@@ -462,13 +464,15 @@ TEST(CudaEvaluationBackend, RigidStructuresAgreeWithTheCpu)
   double     plain = 0.0;
   for (const auto & v : EvaluateAll(*CreateCpuEvaluationBackend(*problem.evaluator, 2), population)[1])
     plain += v.magnitude;
-  problem.UseRigidSlab();
+  // With a strain limit that some candidates exceed: their fold values agree too.
+  problem.UseRigidSlab(1000.0, 0.02);
   auto cpu = CreateCpuEvaluationBackend(*problem.evaluator, 2);
   const auto a = EvaluateAll(*cpu, population);
   double     rigid = 0.0;
   for (const auto & v : a[1])
     rigid += v.magnitude;
   EXPECT_GT(rigid, 1.5 * plain) << "the rigid slab's term should weigh in the test";
+  std::size_t limited = 0; // candidates' tetrahedra beyond the strain limit
   for (const CudaInterpolation interpolation : { CudaInterpolation::Exact, CudaInterpolation::Texture })
   {
     auto        cuda = CreateCudaEvaluationBackend(*problem.evaluator, 2, interpolation);
@@ -488,9 +492,13 @@ TEST(CudaEvaluationBackend, RigidStructuresAgreeWithTheCpu)
           EXPECT_EQ(onCpu.values[i][t].folded, onGpu.values[i][t].folded) << cuda->Name();
           ExpectRelativelyClose(onCpu.values[i][t].magnitude, onGpu.values[i][t].magnitude, 1e-9,
                                 cuda->Name() + " candidate magnitude");
+          ExpectRelativelyClose(onCpu.values[i][t].foldValue, onGpu.values[i][t].foldValue, 1e-9,
+                                cuda->Name() + " candidate fold value");
+          limited += onCpu.values[i][t].foldValue > 0.0 ? 1 : 0;
         }
     }
   }
+  EXPECT_GT(limited, 0u) << "some candidates should exceed the strain limit";
   const GomeaOptions run = problem.Options(31, 12);
   GomeaOptions       sampleAll = run;
   sampleAll.boundRefusals = false;

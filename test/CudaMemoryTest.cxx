@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // The CUDA backend and the device's memory: its estimate grows with the
 // population, a batch larger than the device is reported as out of GPU memory
 // (morea::OutOfDeviceMemory, which RegisterMeshes completes with the run's

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // Tests of morea::ElitistArchive: non-domination, the capacity kept by
 // discretising objective space, checkpoint restore and the stored payload.
 // Core tests: no ITK.

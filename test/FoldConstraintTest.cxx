@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // Tests of fold detection, the constraint value and the Gaussian repair.
 #include "MeshTestSupport.h"
 

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // The checksum of checkpoints and fingerprints: XXH64's reference values, and
 // fingerprints that name the first key that differs.
 #include "morea/Hash.h"

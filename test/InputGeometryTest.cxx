@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // Inputs whose data or geometry are not what their header says are refused
 // with what was measured: MetaImage files with more or less voxel data than
 // DimSize describes (raw and compressed; ITK pads a short compressed stream

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // Test helpers for messages: what an itk::ExceptionObject says, and a
 // substring expectation that prints the whole message when it fails.
 #ifndef morea_test_ItkErrorSupport_h

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // The up-front memory estimate: it grows with the population and the mesh,
 // a population no machine holds is refused at once naming
 // ea_population_size, and the paper's configuration passes.

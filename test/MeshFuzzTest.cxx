@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // Fuzz test of mesh generation: random crop boxes over real organ masks (the
 // abdominal CBCT's stomach, bowel and lungs, the lung CT's lungs) and the
 // phantom's, each box cutting the structures' surfaces somewhere else, at

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // The mesh model end to end on the phantom: random initial solutions
 // rasterised in both directions compose to the identity.
 #include "MeshTestSupport.h"

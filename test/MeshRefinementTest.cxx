@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // Mesh refinement between resolution levels: conforming bisection, exact
 // carry-over of solutions, objective values kept, and the level plan.
 #include "OptimiserTestProblem.h"

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // Tests of what keeps mesh generation from crashing on real surfaces: child
 // processes that take a crash, the checks of constraint surfaces, and the
 // constrained tetrahedralisation falling back to fewer surfaces.

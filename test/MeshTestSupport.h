@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // Shared fixtures of the mesh model tests: a 600-point mesh of the phantom.
 #ifndef MeshTestSupport_h
 #define MeshTestSupport_h

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // itk::MultiObjectiveMeshRegistrationFilter on a small synthetic problem: a
 // bladder that grows from 8 to 11 mm radius and a bone that stays put.
 #include "itkAffineTransform.h"

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // NearContourBlocks: a block is marked exactly when a voxel its samples can
 // read is below the radius, and no interpolated distance below the radius
 // falls in an unmarked block (the CUDA sampling skips its distance fetch

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // The objective data (SPEC 5) of a synthetic problem: intensity and distance
 // channels, guidance weights and the ITK-to-frame conversion.
 #include "itkImageRegionIteratorWithIndex.h"

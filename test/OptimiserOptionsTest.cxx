@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // Optimiser options that cannot work as asked are reported, not quietly
 // changed: more clusters than solutions.
 #include "OptimiserTestProblem.h"

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MO-RV-GOMEA on a small synthetic problem: the archive stays a front, runs
 // are reproducible (seed, threads, evaluation order), checkpoints resume
 // exactly, and the optimiser makes progress.

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // Test helper: a small registration problem for the core optimiser, with no
 // ITK: a 30 mm box meshed by 4x4x4 cubes, a fixed image with a bright ball
 // and a moving image with the ball shifted and larger, and the ball as the one
@@ -138,9 +140,10 @@ struct OptimiserTestProblem
 
   /** A rigid slab: tetrahedra whose centroid has x < 10 mm wholly, those
    *  with x in [10, 15) half (as if straddling a bone's surface). The
-   *  evaluator then adds the rigidity term with `weight`. */
+   *  evaluator then adds the rigidity term with `weight`, and with a
+   *  `strainLimit` its constraint. */
   void
-  UseRigidSlab(double weight = 1000.0)
+  UseRigidSlab(double weight = 1000.0, double strainLimit = 0.0)
   {
     std::vector<double> fraction(topology.NumberOfTetrahedra(), 0.0);
     for (std::size_t t = 0; t < fraction.size(); ++t)
@@ -150,7 +153,7 @@ struct OptimiserTestProblem
         x += 0.25 * base.points[p][0];
       fraction[t] = x < 10.0 ? 1.0 : x < 15.0 ? 0.5 : 0.0;
     }
-    rigidity = morea::BuildRigidityModel(base, fraction, weight);
+    rigidity = morea::BuildRigidityModel(base, fraction, weight, strainLimit);
     evaluator = std::make_unique<morea::TetrahedronEvaluator>(topology, *constraint, elasticity, rigidity, data);
   }
 

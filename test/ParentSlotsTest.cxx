@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // The parent store's bookkeeping: held parents are not uploaded again, slots
 // of parents a batch does not name are reused, equal keys share a slot.
 #include "morea/ParentSlots.h"

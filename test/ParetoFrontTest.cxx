@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // Tests of dominance, non-dominated sorting, the hypervolume and the
 // single-solution selections of morea/ParetoFront.h. Core tests: no ITK.
 #include "morea/Error.h"

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // The phantom suite's cases besides "pelvis" (PhantomTest.cxx): the
 // documented volumes and displacements, bones that do not move, content in
 // one image only, landmarks of every kind, and a truth that is consistent:

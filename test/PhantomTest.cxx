@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // Tests of morea::PelvisPhantom: the analytic deformation and the generated case.
 // Core tests: no ITK headers here.
 #include "morea/Error.h"

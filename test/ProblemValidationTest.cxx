@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // Problems that would register something else than what was asked for are
 // refused before the work: one side of a structure given twice (the second
 // would replace the first), and a guidance structure that preprocessing

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 /*=========================================================================
  *  Tests of the DICOM RT Structure Set import: rasterisation on synthetic
  *  grids, the real TCIA structure sets against the provided reference masks,

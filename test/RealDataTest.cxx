@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // Preprocessing on the real patient pairs in ../shared/data (skipped when absent).
 #include "itkMOREAImageIO.h"
 #include "itkMeshModel.h"

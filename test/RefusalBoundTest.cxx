@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // The refusal bound's rule (RefusalBound.h): which candidates it shows
 // refused before their samples are drawn, and steering.
 #include "OptimiserTestProblem.h"

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // Registration quality metrics against values derived by hand or computed independently.
 #include "itkRegistrationMetrics.h"
 

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // The fold repair's moves (RepairNoise.h): the hand-written logarithm and
 // sine/cosine match the C library to double precision, and the normals are
 // standard normal and a pure function of their key.

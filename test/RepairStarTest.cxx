@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // The fold repair's star terms (RepairStar.h): six times a tetrahedron's
 // oriented volume as an affine function of one corner, for each place of the
 // corner and either orientation of the base volume, and violations that fold

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // Rigid structures in the mesh model: which structures morea_rigid_structures
 // picks on the phantom, whether or not they are guidance structures, and that
 // exactly the tetrahedra overlapping their masks get the rigidity term.

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // The rigidity term of rigid structures (bones): a rigid motion of a rigid
 // region costs nothing, a bend, a squash or a scaling costs more, whichever
 // mesh moves; and the choice of rigid structures by name.
@@ -132,6 +134,50 @@ TEST(RigidityTerm, OnlyRigidTetrahedraCountByTheirShareAndWeight)
   EXPECT_TRUE(BuildRigidityModel(mesh, fraction, 0.0).Empty());
   EXPECT_THROW(BuildRigidityModel(mesh, fraction, -1.0), Error);
   EXPECT_THROW(BuildRigidityModel(mesh, { 1.0 }, 1.0), Error);
+}
+
+TEST(RigidityTerm, TheStrainLimitViolatesLikeAFoldOnlyBeyondItAndOnlyInsideRigidStructures)
+{
+  const TetrahedralMesh mesh = Box();
+  std::vector<double>   fraction(mesh.NumberOfTetrahedra(), 0.0);
+  fraction[3] = 1.0;
+  fraction[7] = 0.4; // mostly outside: the term, but no limit
+  const RigidityModel model = BuildRigidityModel(mesh, fraction, 10.0, 0.05);
+  ASSERT_EQ(model.limitVolumes.size(), mesh.NumberOfTetrahedra());
+  EXPECT_GT(model.limitVolumes[3], 0.0);
+  EXPECT_EQ(model.limitVolumes[7], 0.0);
+  EXPECT_EQ(model.limitVolumes[0], 0.0);
+  EXPECT_DOUBLE_EQ(model.strainLimitSquared, 0.0025);
+  EXPECT_TRUE(BuildRigidityModel(mesh, fraction, 10.0).limitVolumes.empty()); // no limit
+  EXPECT_THROW(BuildRigidityModel(mesh, fraction, 10.0, -0.1), Error);
+
+  const auto & base = mesh.points;
+  const Tetrahedron & hard = mesh.tetrahedra[3];
+  const std::array<Vec3, 4> r{ base[hard[0]], base[hard[1]], base[hard[2]], base[hard[3]] };
+  // A rigid motion and a 2 % stretch stay within 0.05; a 20 % stretch does not.
+  std::array<Vec3, 4> moved, small, large;
+  for (int i = 0; i < 4; ++i)
+  {
+    moved[i] = RigidMotion(r[i], 0.9, { { 4.0, 1.0, -2.0 } });
+    small[i] = Vec3{ { 1.02 * r[i][0], r[i][1], r[i][2] } };
+    large[i] = Vec3{ { 1.2 * r[i][0], r[i][1], r[i][2] } };
+  }
+  double violated = 0.0;
+  EXPECT_EQ(TetrahedronRigidViolation(model, 3, r, moved, violated), 0.0);
+  EXPECT_EQ(TetrahedronRigidViolation(model, 3, r, small, violated), 0.0);
+  EXPECT_EQ(violated, 0.0);
+  const double value = TetrahedronRigidViolation(model, 3, r, large, violated);
+  EXPECT_EQ(violated, 1.0);
+  // (E_xx = (1.2^2 - 1) / 2 = 0.22)^2 beyond 0.05^2, times the volume.
+  EXPECT_NEAR(value, (0.22 * 0.22 - 0.0025) * model.limitVolumes[3], 1e-9);
+  // Outside the limit's tetrahedra nothing, however large the strain.
+  const Tetrahedron & soft = mesh.tetrahedra[7];
+  const std::array<Vec3, 4> s{ base[soft[0]], base[soft[1]], base[soft[2]], base[soft[3]] };
+  std::array<Vec3, 4>       stretched = s;
+  for (auto & p : stretched)
+    p[0] *= 1.5;
+  EXPECT_EQ(TetrahedronRigidViolation(model, 7, s, stretched, violated), 0.0);
+  EXPECT_EQ(violated, 1.0);
 }
 
 TEST(RigidityTerm, FlatTetrahedraSquashedAcrossTheirThinSideCostMoreThanTheirEdgesChange)

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // Tests of the order in which the CUDA texture path's warps take a
 // tetrahedron's Sobol samples (morea/SampleCosets.h).
 #include "morea/SampleCosets.h"

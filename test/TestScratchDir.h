@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // A fresh, empty scratch folder for the running test, under the build's
 // test output folder: <MOREA_TEST_OUTPUT_DIR>/<suite>/<test name>, so that
 // tests run in parallel (ctest -j) never see each other's files.

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // Tests of the mesh model's geometry, point placement, tetrahedralisation and
 // the generated phantom mesh.
 #include "MeshTestSupport.h"

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // The objectives per tetrahedron: exact partial evaluation, the background
 // rule, guidance truncation, and CPU backend batches.
 #include "OptimiserTestProblem.h"
@@ -123,6 +125,44 @@ TEST(TetrahedronObjectives, SumOfPartialEvaluationsEqualsFullEvaluationWithRigid
   OptimiserTestProblem problem;
   problem.UseRigidSlab();
   ExpectPartialEvaluationsSumToTheFullOne(problem);
+}
+
+TEST(TetrahedronObjectives, AStrainLimitKeepsTheFrontsRigidStructuresWithinIt)
+{
+  OptimiserTestProblem problem;
+  problem.UseRigidSlab(1000.0, 0.02);
+  ExpectPartialEvaluationsSumToTheFullOne(problem);
+  // Initial deformations strain the slab beyond 0.02: those solutions
+  // violate the constraint like folded ones.
+  const auto  population = problem.InitialPopulation(problem.Options());
+  std::size_t beyond = 0;
+  for (const auto & s : population)
+    beyond += FullTotals(*problem.evaluator, s).ToFitness(problem.topology.NumberOfTetrahedra()).feasible ? 0 : 1;
+  EXPECT_GT(beyond, 0u);
+  // The optimiser keeps only solutions within it in its archive; the
+  // refusal bound changes none of its decisions.
+  auto        backend = CreateCpuEvaluationBackend(*problem.evaluator, 2);
+  GomeaOptions options = problem.Options(7, 10);
+  MoRvGomea   optimiser(problem.base, problem.topology, problem.parallel, *problem.constraint, *backend, options);
+  optimiser.Initialize(problem.InitialPopulation(options));
+  optimiser.Run();
+  ASSERT_GT(optimiser.Archive().Size(), 0u);
+  for (const auto & e : optimiser.Archive().Entries())
+    for (std::size_t t = 0; t < problem.topology.NumberOfTetrahedra(); ++t)
+    {
+      double violated = 0.0;
+      const auto & tet = problem.topology.Tetrahedra()[t];
+      EXPECT_EQ(TetrahedronRigidViolation(problem.rigidity, t, CornersOf(tet, e.solution.source),
+                                          CornersOf(tet, e.solution.target), violated),
+                0.0);
+    }
+  options.boundRefusals = false;
+  MoRvGomea unbounded(problem.base, problem.topology, problem.parallel, *problem.constraint, *backend, options);
+  unbounded.Initialize(problem.InitialPopulation(options));
+  unbounded.Run();
+  ASSERT_EQ(unbounded.Archive().Size(), optimiser.Archive().Size());
+  for (std::size_t i = 0; i < optimiser.Archive().Size(); ++i)
+    EXPECT_EQ(unbounded.Archive().Entries()[i].fitness.objectives, optimiser.Archive().Entries()[i].fitness.objectives);
 }
 
 TEST(TetrahedronObjectives, RigidStructuresAddTheirTermToTheMagnitude)

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // The thread pool: every index runs exactly once whatever the count and the
 // number of threads, an exception reaches the caller and stops the work, and
 // the pool stays usable for the next call.

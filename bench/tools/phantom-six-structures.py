@@ -1,4 +1,6 @@
 #!/usr/bin/env python3
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 """A problem folder with six guidance structures from the pelvis phantom.
 
 Reads a folder written by `morea phantom` and writes one in the same layout

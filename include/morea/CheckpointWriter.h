@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration core: checkpoints written behind the optimiser.
 // A checkpoint of the paper's configuration is about 50 MB; written every ten
 // generations by the thread that runs them, the checkpoints and the initial

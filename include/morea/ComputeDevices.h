@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration core: which CUDA devices this build can use.
 // Implemented by the CUDA library when the build has CUDA, and by a CPU-only
 // translation unit otherwise, so callers never need #ifdefs.

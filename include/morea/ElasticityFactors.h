@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration core: per-tetrahedron tissue elasticity factors
 // of the deformation magnitude objective (SPEC 4.5, paper appendix A).
 #ifndef morea_ElasticityFactors_h

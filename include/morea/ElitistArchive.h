@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration core: the elitist archive of MO-RV-GOMEA (SPEC 5):
 // every feasible non-dominated solution found so far, up to a capacity kept by
 // discretising objective space (Luong & Bosman 2012).

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration core: the exception type the core throws, and the
 // one kind of it a caller may want to tell apart.
 #ifndef morea_Error_h

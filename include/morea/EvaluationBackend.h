@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration core: the evaluation backend interface (SPEC 6).
 // The optimiser hands a backend whole batches: all solutions to evaluate in
 // full, or all partial candidates of one parallel group for all solutions of

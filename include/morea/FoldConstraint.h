@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration core: mesh folds (SPEC 5, constraint). A mesh has
 // folded where a tetrahedron's signed volume no longer has the sign it had in
 // the base mesh; the constraint value is the sum of the folded tetrahedra's

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration core: a 64-bit checksum of bytes (XXH64, written
 // out here so the core needs no library for it), for checkpoints that must
 // not be read when damaged and for fingerprints of a run's inputs.

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration core: the initial population (SPEC 5): the base
 // mesh pair plus fold-free random deformations from Gaussian radial basis
 // kernels that pull mesh points towards them, in incremental rounds.

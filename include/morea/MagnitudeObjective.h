@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration core: the deformation magnitude objective (SPEC 5),
 // per tetrahedron so that partial evaluation is exact.
 #ifndef morea_MagnitudeObjective_h

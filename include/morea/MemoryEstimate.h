@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration core: the memory a run needs, estimated before
 // the optimisation, against what is free. A population or archive too large
 // for the machine is refused with the figures, rather than ending in

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration mesh generation: the base mesh of a registration
 // problem (SPEC 4.3): spread-out contour points per structure, optional
 // structure surfaces as constraints, random points, the domain's corners, and

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration core: dense displacement fields from a solution's
 // two meshes (the piecewise-affine map between twin tetrahedra).
 #ifndef morea_MeshRasterizer_h

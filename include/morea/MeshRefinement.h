@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration core: refining a mesh between resolution levels.
 //
 // Conforming longest-edge bisection: an edge is split at its midpoint and

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration core: the Gaussian repair operator (SPEC 5,
 // morea_repair_method = "gaussian") that moves points of folded tetrahedra
 // until the mesh is fold-free again.

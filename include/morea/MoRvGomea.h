@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration core: MO-RV-GOMEA (SPEC 5), the multi-objective
 // real-valued gene-pool optimal mixing evolutionary algorithm, specialised to
 // the dual-dynamic mesh: FOS elements are mesh edges (6 variables per point),

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration core: the blocks of an image where an
 // interpolated contour distance may lie below the guidance radius. Guidance
 // counts only samples within the radius of a contour, and with tetrahedra far

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration core: what the intensity and guidance objectives
 // sample (SPEC 5): per image one multi-channel volume holding the windowed
 // intensity and, per guidance structure, the distance to its contour, so that

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration core: one run per output folder.
 #ifndef morea_OutputFolderLock_h
 #define morea_OutputFolderLock_h

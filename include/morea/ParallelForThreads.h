@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration core: a one-off parallel loop on threads of its
 // own, for the few long loops that run outside the optimiser's pool (and may
 // run beside other such loops, where the shared pool would serialise them).

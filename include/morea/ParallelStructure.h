@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration core: the linkage model of the mesh (SPEC 4.4).
 // FOS elements are edges chosen by a greedy set cover of the points; elements
 // whose dependent tetrahedra overlap interact; DSATUR colours the interaction

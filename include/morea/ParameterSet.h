@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration core: the run parameters and their TOML reader.
 //
 // Keys are the MOREA paper's parameter-file keys (appendix A listing) plus the

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration core: where a backend keeps the parents of
 // partial candidates between batches. Successive batches of a generation
 // share most of their parents (a batch changes the few solutions whose

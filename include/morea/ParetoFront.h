@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration core: objective vectors, constraint domination,
 // non-dominated sorting, hypervolume and the helpers that pick one solution of
 // an approximation set (SPEC 5 and 7).

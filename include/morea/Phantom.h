@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration core: a deterministic synthetic pelvis-like image
 // pair with a known large deformation (a bladder that fills), for examples,
 // tests and the default run. No ITK here: the ITK layer converts the volumes.

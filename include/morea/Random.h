@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration core: a seeded random generator whose sequence is
 // the same on every platform and compiler (std::normal_distribution is not).
 #ifndef morea_Random_h

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration core: the Gaussian moves of the fold repair.
 // Each trial's move is a pure function of (seed, pass, point, trial), not a
 // draw from a running stream, so that the trials of one point can be drawn in

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration core: the fold repair's view of one point's
 // tetrahedra (its star). While the repair tries positions x for one point,
 // the other corners stay put, so six times each tetrahedron's oriented volume

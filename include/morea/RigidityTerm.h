@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration core: rigid structures (bones) in the deformation
 // magnitude objective. The edge term fades where a bone is not a guidance
 // structure (no mesh points on it, tetrahedra straddling it) and barely sees
@@ -26,6 +28,14 @@ struct RigidityModel
   /** Per tetrahedron 9 numbers: the inverse of the base mesh's edge matrix
    *  [p1 - p0, p2 - p0, p3 - p0], row-major. */
   std::vector<double> inverseEdges;
+  /** The strain limit's constraint (morea_rigid_strain_limit): per
+   *  tetrahedron at least half inside a rigid structure, its |base volume|
+   *  (0 elsewhere; empty without a limit), and the limit squared. Such a
+   *  tetrahedron whose deviation exceeds it counts as violated, like a fold,
+   *  with (deviation - limit^2) * volume as its constraint value: a soft term
+   *  alone lets the solutions at the front's best-guidance end bend bones. */
+  std::vector<double> limitVolumes;
+  double              strainLimitSquared{ 0.0 };
 
   bool
   Empty() const
@@ -37,7 +47,8 @@ struct RigidityModel
 /** The model for `base` with `rigidFraction[t]` of tetrahedron t inside a
  *  rigid structure; empty when no fraction is positive or `weight` is 0. */
 RigidityModel
-BuildRigidityModel(const TetrahedralMesh & base, const std::vector<double> & rigidFraction, double weight);
+BuildRigidityModel(const TetrahedralMesh & base, const std::vector<double> & rigidFraction, double weight,
+                   double strainLimit = 0.0);
 
 /** ||E_target - E_source||_F^2: E = (G^T G - I) / 2 is the Green strain of a
  *  mesh's tetrahedron against the base one (G = D B^-1, D its edge matrix),
@@ -53,6 +64,13 @@ TetrahedronRigidDeviation(const std::array<Vec3, 4> & source, const std::array<V
 double
 TetrahedronRigidity(const RigidityModel & model, std::size_t t, const std::array<Vec3, 4> & source,
                     const std::array<Vec3, 4> & target);
+
+/** The strain limit's constraint value of tetrahedron t (0 when within it,
+ *  outside rigid structures or without a limit); adds 1 to `violated` when
+ *  it is exceeded. */
+double
+TetrahedronRigidViolation(const RigidityModel & model, std::size_t t, const std::array<Vec3, 4> & source,
+                          const std::array<Vec3, 4> & target, double & violated);
 
 /** Whether a structure's name says it is bone: bone(s), femur, femoral head,
  *  pelvic bone, sacrum, vertebra, spine, skull, rib (any case, any separator). */

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration core: what a run's front depends on, as a list of
 // key = value entries (inputs, preprocessing and objective parameters, the
 // mesh). A checkpoint stores it, and a resume whose fingerprint differs is

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration core: the order in which a GPU's warps take a
 // tetrahedron's Sobol samples (the CUDA backend's texture path).
 //

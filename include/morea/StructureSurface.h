@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration mesh generation: the surface of a structure as a
 // closed triangle mesh, to constrain the tetrahedralisation (its triangles
 // become mesh faces, so the mesh follows the organ's boundary).

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration mesh generation: checks of constraint surfaces
 // before TetGen sees them. A decimated marching-cubes surface can fold onto
 // itself where the structure is thin, or come apart where the crop cuts it,

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration core: the dual-dynamic tetrahedral mesh model.
 //
 // One topology (tetrahedra over point indices) is shared by two point sets:

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration mesh generation: Delaunay tetrahedralisation of
 // points (TetGen), optionally constrained so that given triangles are faces.
 #ifndef morea_Tetrahedralization_h

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration core: the three objectives and the fold
 // constraint, computed per tetrahedron (SPEC 5) so that a partial evaluation
 // (the dependent tetrahedra of one FOS element) updates a solution's totals

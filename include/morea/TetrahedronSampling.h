@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration core: sample points inside a tetrahedron
 // (SPEC 5, intensity objective): barycentric coordinates from a 4D Sobol
 // sequence, scrambled by a digital shift seeded from the tetrahedron's own

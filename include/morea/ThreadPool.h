@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration core: a fixed set of worker threads that run
 // index ranges (the CPU backend's parallel loops), kept alive between calls
 // because the optimiser issues many short loops per generation.

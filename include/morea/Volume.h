@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration core: a plain 3D voxel grid with axis-aligned
 // physical geometry (the core's exchange format with the ITK layer).
 #ifndef morea_Volume_h

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration mesh export: VTK XML unstructured grids (.vtu)
 // that ParaView and 3D Slicer read.
 #ifndef morea_VtuWriter_h

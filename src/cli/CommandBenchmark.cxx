@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // `morea benchmark`: times MO-RV-GOMEA on a real problem with each evaluation
 // backend (SPEC 6): per-generation wall time, partial evaluations and sample
 // points per second, kernel time, peak GPU memory, the GPU's own coherent

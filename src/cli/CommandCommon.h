@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // Shared pieces of the `morea` subcommands: loading a problem from options or
 // a problem folder, parameters, and plain-text output helpers.
 #ifndef morea_cli_CommandCommon_h
@@ -87,6 +89,12 @@ AddInfoCommand(CLI::App & app);
 /** `morea parameters` */
 void
 AddParametersCommand(CLI::App & app);
+/** `morea batch`: runs the Python package's cohort batch */
+void
+AddBatchCommand(CLI::App & app);
+/** `morea view`: the front navigator page of a run's folder. */
+void
+AddViewCommand(CLI::App & app);
 } // namespace morea::cli
 
 #endif

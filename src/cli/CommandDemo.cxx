@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // `morea demo`: the default job on the embedded phantom. Generates the phantom,
 // preprocesses it, and scores the rigid baseline and the known true
 // deformation with the evaluation pipeline.

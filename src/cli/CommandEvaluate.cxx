@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // `morea evaluate`: scores a registration (or the identity baseline) on a problem.
 #include "CommandCommon.h"
 

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // `morea mesh`: builds the mesh model of a problem and writes it for inspection.
 #include "CommandCommon.h"
 

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // `morea parameters`: every parameter key with its type, default, range and
 // meaning, from the parameter table itself (docs/parameters.md is its output).
 #include "CommandCommon.h"

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // `morea phantom`: writes a case of the synthetic pelvis suite with its ground truth.
 #include "CommandCommon.h"
 

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // `morea preprocess`: resample, pre-align, crop, window; writes a problem folder.
 #include "CommandCommon.h"
 

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // `morea register`: preprocesses a problem, runs MOREA and writes the
 // approximation set, the chosen solutions and their scores.
 #include "CommandCommon.h"

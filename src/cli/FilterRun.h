@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // The CLI's one way to register: a loaded problem handed to
 // itk::MultiObjectiveMeshRegistrationFilter (`morea register`, `morea demo`).
 #ifndef morea_cli_FilterRun_h

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // The terminal progress line of `morea register` and `morea demo`.
 #ifndef morea_cli_ProgressPrinter_h
 #define morea_cli_ProgressPrinter_h

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 #include "ZipArchive.h"
 
 #include "itkMOREAImageIO.h"

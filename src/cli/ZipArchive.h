@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // A folder archived as one .zip file (the `zip` parameter key).
 #ifndef morea_cli_ZipArchive_h
 #define morea_cli_ZipArchive_h

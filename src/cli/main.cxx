@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // The `morea` command line: multi-objective deformable registration (MOREA).
 #include "CommandCommon.h"
 
@@ -21,6 +23,8 @@ main(int argc, char ** argv)
   morea::cli::AddBenchmarkCommand(app);
   morea::cli::AddInfoCommand(app);
   morea::cli::AddParametersCommand(app);
+  morea::cli::AddBatchCommand(app);
+  morea::cli::AddViewCommand(app);
   try
   {
     app.parse(argc, argv);

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // The CPU evaluation backend: the reference implementation of
 // EvaluationBackend, multi-threaded over the tetrahedra of whole solutions and
 // over the candidates of a parallel group.

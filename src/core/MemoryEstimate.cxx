@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // The memory a run needs against what is free (MemoryEstimate.h), and the
 // optimiser's part of it (MoRvGomea::MemoryFor), counted from the types it
 // keeps (MoRvGomeaParts.h).

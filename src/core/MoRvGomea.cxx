@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MO-RV-GOMEA (MoRvGomea.h): set-up, the population's evaluation and the
 // generation: models, batches drawn and evaluated in turn, bookkeeping.
 // Its models and acceptance are in MoRvGomeaModels.cxx and
@@ -228,8 +230,17 @@ MoRvGomea::Initialize(std::vector<DualMesh> population, const std::vector<DualMe
         worst[m] = std::max(worst[m], f.objectives[m]);
     InsertIntoArchive(s, f);
   }
+  // With no feasible solution yet (a rigid strain limit the initial
+  // deformations exceed, say), the whole population sets the scales.
+  ObjectiveVector worstOfAll{ { 0.0, 0.0, 0.0 } };
+  for (std::size_t s = 0; s < m_Population.size(); ++s)
+    for (std::size_t m = 0; m < NumberOfObjectives; ++m)
+      worstOfAll[m] = std::max(worstOfAll[m], CurrentFitness(s).objectives[m]);
   for (std::size_t m = 0; m < NumberOfObjectives; ++m)
-    m_Reference[m] = worst[m] > 0.0 ? 1.1 * worst[m] : 1.0;
+  {
+    const double w = worst[m] > 0.0 ? worst[m] : worstOfAll[m];
+    m_Reference[m] = w > 0.0 && std::isfinite(w) ? 1.1 * w : 1.0;
+  }
   // In batches: the per-tetrahedron values of a whole carried archive on a
   // fine mesh would take gigabytes at once.
   constexpr std::size_t batch = 256;

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // A batch of MO-RV-GOMEA's candidates: the backend's view of it, its
 // evaluation and its acceptance in a fixed order; and forced improvements.
 #include "MoRvGomeaParts.h"

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // Checkpoints of MO-RV-GOMEA: the population (with its accumulated objective
 // totals, which a fresh evaluation would reproduce only to rounding), ids,
 // stall counters, the archive, the adaptive distribution state, the history

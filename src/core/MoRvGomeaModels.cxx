@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MO-RV-GOMEA's models: selection, clustering in objective space and the
 // per-cluster, per-element normal distributions candidates are drawn from,
 // with their adaptive multipliers.

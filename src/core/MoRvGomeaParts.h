@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // The optimiser's internal types, shared by its source files
 // (MoRvGomea.cxx: the generation; MoRvGomeaModels.cxx: selection,
 // clustering and the distributions; MoRvGomeaAcceptance.cxx: a batch's

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 #include "morea/RigidityTerm.h"
 
 #include "morea/Error.h"
@@ -57,7 +59,8 @@ Lower(std::string s)
 } // namespace
 
 RigidityModel
-BuildRigidityModel(const TetrahedralMesh & base, const std::vector<double> & rigidFraction, double weight)
+BuildRigidityModel(const TetrahedralMesh & base, const std::vector<double> & rigidFraction, double weight,
+                   double strainLimit)
 {
   const std::size_t n = base.NumberOfTetrahedra();
   if (rigidFraction.size() != n)
@@ -65,6 +68,8 @@ BuildRigidityModel(const TetrahedralMesh & base, const std::vector<double> & rig
                 " tetrahedra");
   if (!(weight >= 0.0) || !std::isfinite(weight))
     throw Error("rigidity: the weight must be finite and non-negative");
+  if (!(strainLimit >= 0.0) || !std::isfinite(strainLimit))
+    throw Error("rigidity: the strain limit must be finite and non-negative");
   RigidityModel model;
   if (weight == 0.0 || std::none_of(rigidFraction.begin(), rigidFraction.end(), [](double f) { return f > 0.0; }))
     return model;
@@ -82,6 +87,14 @@ BuildRigidityModel(const TetrahedralMesh & base, const std::vector<double> & rig
     // A degenerate base tetrahedron has no strain to measure: it keeps weight 0.
     if (rigidFraction[t] > 0.0 && InvertEdges(corners, &model.inverseEdges[9 * t]))
       model.weights[t] = weight * rigidFraction[t] * std::abs(SignedVolume(tet, base.points)) / length;
+  }
+  if (strainLimit > 0.0)
+  {
+    model.strainLimitSquared = strainLimit * strainLimit;
+    model.limitVolumes.assign(n, 0.0);
+    for (std::size_t t = 0; t < n; ++t)
+      if (rigidFraction[t] >= 0.5 && model.weights[t] > 0.0)
+        model.limitVolumes[t] = std::abs(SignedVolume(base.tetrahedra[t], base.points));
   }
   return model;
 }
@@ -113,6 +126,19 @@ TetrahedronRigidity(const RigidityModel & model, std::size_t t, const std::array
   if (model.Empty() || model.weights[t] == 0.0)
     return 0.0;
   return model.weights[t] * TetrahedronRigidDeviation(source, target, &model.inverseEdges[9 * t]);
+}
+
+double
+TetrahedronRigidViolation(const RigidityModel & model, std::size_t t, const std::array<Vec3, 4> & source,
+                          const std::array<Vec3, 4> & target, double & violated)
+{
+  if (model.limitVolumes.empty() || model.limitVolumes[t] == 0.0)
+    return 0.0;
+  const double deviation = TetrahedronRigidDeviation(source, target, &model.inverseEdges[9 * t]);
+  if (!(deviation > model.strainLimitSquared))
+    return 0.0;
+  violated += 1.0;
+  return (deviation - model.strainLimitSquared) * model.limitVolumes[t];
 }
 
 bool

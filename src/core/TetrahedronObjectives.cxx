@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 #include "morea/TetrahedronObjectives.h"
 
 #include "morea/Error.h"
@@ -130,6 +132,7 @@ TetrahedronEvaluator::EvaluateCorners(std::size_t t, const Corners & source, con
     v.foldValue += m_Constraint->TetrahedronViolation(t, (*c)[0], (*c)[1], (*c)[2], (*c)[3], folded);
     v.folded += folded ? 1.0 : 0.0;
   }
+  v.foldValue += TetrahedronRigidViolation(*m_Rigidity, t, source, target, v.folded);
   v.samples = static_cast<double>(SampleCount(source)) + static_cast<double>(SampleCount(target));
   return v;
 }

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // Builds the corners of every dependent tetrahedron of a batch of partial
 // candidates on the device, from the parents' points and each candidate's
 // moved points, so that the host uploads a few megabytes of points per batch

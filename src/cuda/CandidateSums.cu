@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // Per-candidate sums of a batch's tetrahedron values on the device: the host
 // needs every tetrahedron's values only for the few candidates it accepts
 // (about 2 % of a generation's late in a paper-scale run), but the sum over

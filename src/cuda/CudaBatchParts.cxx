@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // The CUDA backend's batches on the device, part by part: fold checks and
 // their outcome, the sampling's set-up and kernels, and the values and sums
 // handed back as each part ends.

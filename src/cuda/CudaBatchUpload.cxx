@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // The CUDA backend's images and batches on their way up: the volumes and
 // their textures, a batch's candidates packed on the host, its tables,
 // parents and ranges uploaded and queued, and its refusal screen.

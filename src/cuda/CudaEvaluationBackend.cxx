@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // The CUDA evaluation backend's construction and calls (see
 // CudaEvaluationBackend.h).
 #include "CudaEvaluationBackend.h"
@@ -45,6 +47,11 @@ CudaEvaluationBackend::CudaEvaluationBackend(const TetrahedronEvaluator & evalua
   {
     m_Constants.rigidWeights = Upload(evaluator.Rigidity().weights, m_RigidWeights);
     m_Constants.rigidInverseEdges = Upload(evaluator.Rigidity().inverseEdges, m_RigidInverseEdges);
+    if (!evaluator.Rigidity().limitVolumes.empty())
+    {
+      m_Constants.rigidLimitVolumes = Upload(evaluator.Rigidity().limitVolumes, m_RigidLimitVolumes);
+      m_Constants.rigidStrainLimitSquared = evaluator.Rigidity().strainLimitSquared;
+    }
   }
   m_Constants.referenceVolumes = Upload(evaluator.Constraint().ReferenceVolumes(), m_ReferenceVolumes);
   m_Constants.tetrahedra = static_cast<std::uint32_t>(evaluator.Constraint().ReferenceVolumes().size());

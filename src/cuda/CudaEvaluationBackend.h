@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // The CUDA evaluation backend: the same calls as the CPU backend
 // (CpuEvaluationBackend.cxx), evaluated on the GPU. Images, distance maps,
 // the mesh and per-tetrahedron constants are uploaded once. A batch of
@@ -690,7 +692,7 @@ private:
   cuda::DeviceArray<float>      m_Moving, m_Fixed, m_PackedMoving, m_PackedFixed;
   VolumeTextures m_MovingTextures, m_FixedTextures;
   cuda::DeviceArray<double>     m_GuidanceWeights, m_Elasticity, m_ReferenceVolumes;
-  cuda::DeviceArray<double>     m_RigidWeights, m_RigidInverseEdges;
+  cuda::DeviceArray<double>     m_RigidWeights, m_RigidInverseEdges, m_RigidLimitVolumes;
   cuda::PinnedArray<double>        m_HostSolutionPoints; ///< whole solutions' points, staged
   cuda::DeviceArray<double>        m_SolutionPoints;
   // Partial candidates: the mesh once, then per batch (device and staging).

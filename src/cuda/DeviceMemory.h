@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // RAII owners for CUDA device and pinned host memory, and the one place that
 // turns a CUDA status into an exception. Private to src/cuda: nothing outside
 // the CUDA library sees CUDA headers.

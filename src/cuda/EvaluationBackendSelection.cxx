@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // The one place that chooses between the CPU and CUDA evaluation backends.
 #include "morea/ComputeDevices.h"
 #include "morea/Error.h"

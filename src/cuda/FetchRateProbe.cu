@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // A yardstick for the tetrahedron kernels: how many hardware-filtered
 // trilinear fetches per second the GPU serves from a 3D float texture when
 // neighbouring threads read neighbouring points (the coherent best case).

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // The fold check and the Gaussian repair of partial candidates on the device,
 // mirroring CheckCandidateFolds / RepairPoints (src/core): the same points in
 // the same order, the same moves (RepairNoise.h), the same star terms

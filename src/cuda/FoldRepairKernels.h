@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // Launcher of the CUDA fold check and repair of partial candidates, in plain
 // C++ types (see TetrahedronKernels.h).
 #ifndef morea_cuda_FoldRepairKernels_h

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // CPU-only builds: there is no CUDA backend to offer.
 #include "morea/ComputeDevices.h"
 #include "morea/Error.h"

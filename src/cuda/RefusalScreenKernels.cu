@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // The refusal screen on the device (see RefusalScreenKernels.h). Its answer
 // is a hint: the optimiser checks every skipped candidate exactly on the
 // host and has those it does not refuse sampled, so rounding that differs
@@ -96,6 +98,8 @@ ScreenCandidates(EvaluationConstants k, CandidateBatch batch, const double * __r
       sums[1] += SampleCount(k.samplingRate, k.voxelVolume, source) + SampleCount(k.samplingRate, k.voxelVolume, target);
       sums[2] += VolumeViolation(SignedVolume(source), k.referenceVolumes[t], k.volumeFraction, folded);
       sums[2] += VolumeViolation(SignedVolume(target), k.referenceVolumes[t], k.volumeFraction, folded);
+      sums[2] += RigidViolation(k.rigidLimitVolumes, k.rigidStrainLimitSquared, k.rigidInverseEdges, t, source, target,
+                                folded);
       sums[3] += folded;
     }
   const bool screened = b.screened != 0 && end > first && __all_sync(0xffffffffu, sampled);

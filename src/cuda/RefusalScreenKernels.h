@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // Launchers of the refusal screen (morea/RefusalBound.h) on the device, in
 // plain C++ types: the rule of morea::RefusedWhateverItsSamples applied to
 // every candidate of a batch once its corners are built, and the gathering

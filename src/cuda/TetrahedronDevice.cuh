@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // Device functions shared by the tetrahedron kernels (TetrahedronKernels.cu,
 // TextureKernels.cu): the seeds, Sobol shifts, volumes and magnitude exactly
 // as the CPU's TetrahedronEvaluator computes them. Included by .cu files only.
@@ -231,6 +233,21 @@ ItemMagnitude(const double * elasticity, const double * rigidWeights, const doub
   return m;
 }
 
+/** TetrahedronRigidViolation of morea/RigidityTerm.h: the strain limit's
+ *  constraint value (limitVolumes null: no limit). */
+inline __device__ double
+RigidViolation(const double * limitVolumes, double limitSquared, const double * rigidInverseEdges, std::uint32_t t,
+               const double source[12], const double target[12], double & violated)
+{
+  if (limitVolumes == nullptr || limitVolumes[t] == 0.0)
+    return 0.0;
+  const double deviation = TetrahedronRigidDeviation(source, target, rigidInverseEdges + 9 * static_cast<std::size_t>(t));
+  if (!(deviation > limitSquared))
+    return 0.0;
+  violated += 1.0;
+  return __dmul_rn(__dsub_rn(deviation, limitSquared), limitVolumes[t]);
+}
+
 inline __device__ double
 WarpSum(double x)
 {
@@ -241,15 +258,18 @@ WarpSum(double x)
 
 /** An item's values besides its samples' (ItemValues' layout: magnitude,
  *  fold value, folded count) for tetrahedron t with corners `source` and
- *  `target`; the magnitude as ItemMagnitude. */
+ *  `target`; the magnitude as ItemMagnitude, the fold value with the rigid
+ *  strain limit's (RigidViolation). */
 inline __device__ void
 WriteItemValues(const double * referenceVolumes, double volumeFraction, const double * elasticity,
-                const double * rigidWeights, const double * rigidInverseEdges, std::uint32_t t,
-                const double source[12], const double target[12], double * out)
+                const double * rigidWeights, const double * rigidInverseEdges, const double * rigidLimitVolumes,
+                double rigidStrainLimitSquared, std::uint32_t t, const double source[12], const double target[12],
+                double * out)
 {
   double folded = 0.0;
   double value = VolumeViolation(SignedVolume(source), referenceVolumes[t], volumeFraction, folded);
   value += VolumeViolation(SignedVolume(target), referenceVolumes[t], volumeFraction, folded);
+  value += RigidViolation(rigidLimitVolumes, rigidStrainLimitSquared, rigidInverseEdges, t, source, target, folded);
   out[0] = ItemMagnitude(elasticity, rigidWeights, rigidInverseEdges, t, source, target);
   out[1] = value;
   out[2] = folded;

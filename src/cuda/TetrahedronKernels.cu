@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // CUDA kernels of the tetrahedron objectives. Each warp evaluates one
 // direction of one tetrahedron: the samples are spread over its lanes and
 // reduced with shuffles. The arithmetic mirrors TetrahedronEvaluator (same
@@ -240,6 +242,7 @@ EvaluateTetrahedraKernel(EvaluationConstants k, View moving, View fixed, const d
   if (direction == 0) // from = source, to = target
   {
     WriteItemValues(k.referenceVolumes, k.volumeFraction, k.elasticity, k.rigidWeights, k.rigidInverseEdges,
+                    k.rigidLimitVolumes, k.rigidStrainLimitSquared,
                     tetrahedra[item], from, to, itemOut + item * ItemValues);
   }
 }

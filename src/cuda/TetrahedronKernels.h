@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // Launchers of the CUDA tetrahedron kernels, in plain C++ types so that the
 // backend's host code and nvcc share no headers beyond this one.
 #ifndef morea_cuda_TetrahedronKernels_h
@@ -111,6 +113,10 @@ struct EvaluationConstants
    *  and 9 numbers of the base edge matrix's inverse; null without rigid structures. */
   const double *  rigidWeights{ nullptr };
   const double *  rigidInverseEdges{ nullptr };
+  /** The rigid strain limit's constraint: per tetrahedron its base volume
+   *  where it holds (0 elsewhere), null without a limit; the limit squared. */
+  const double *  rigidLimitVolumes{ nullptr };
+  double          rigidStrainLimitSquared{ 0.0 };
   const double *  referenceVolumes{ nullptr }; ///< signed base volume per tetrahedron
   std::uint32_t   tetrahedra{ 0 };             ///< of the mesh
   double          volumeFraction{ 0.0 };

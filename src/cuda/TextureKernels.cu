@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // The texture-interpolation path of the tetrahedron evaluation, built for
 // throughput. Work that is the same for all samples of a tetrahedron (the
 // seed hash, Sobol shifts, sample count, corners in texel coordinates) runs
@@ -279,6 +281,7 @@ PrepareTextureTasks(EvaluationConstants k, const double * __restrict__ corners,
       itemIndex[item] = static_cast<std::uint32_t>(item);
 
     WriteItemValues(k.referenceVolumes, k.volumeFraction, k.elasticity, k.rigidWeights, k.rigidInverseEdges,
+                    k.rigidLimitVolumes, k.rigidStrainLimitSquared,
                     tetrahedra[item], source, target, itemOut + item * ItemValues);
   }
   __syncthreads();

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 /*=========================================================================
  *  MultiObjectiveRegistration: checks that an input's voxel data and
  *  geometry are what its header says (the ITK layer's own header).

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // Gzip compression of a whole file on several threads, as one gzip member.
 #ifndef morea_ParallelGzip_h
 #define morea_ParallelGzip_h

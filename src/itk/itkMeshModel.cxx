@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 #include "itkMeshModel.h"
 
 #include "itkMOREAImageIO.h"
@@ -103,7 +105,8 @@ DeriveMeshModelParts(const RegistrationProblem & problem, const ::morea::Paramet
   }
   if (!rigidMaskPointers.empty())
     model.rigidity = ::morea::BuildRigidityModel(model.base, ::morea::UnionOverlapFractions(model.base, rigidMaskPointers),
-                                                 parameters.GetReal("morea_rigid_weight"));
+                                                 parameters.GetReal("morea_rigid_weight"),
+                                                 parameters.GetReal("morea_rigid_strain_limit"));
   model.report.secondsElasticity = SecondsSince(start);
 }
 } // namespace

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 #include "itkRegistrationOutputs.h"
 
 #include "itkContourOverlayRenderer.h"
@@ -6,6 +8,8 @@
 #include "itkMeshTransforms.h"
 #include "itkMinimumMaximumImageCalculator.h"
 #include "itkRegistrationMetrics.h"
+#include "itkRegistrationPlots.h"
+#include "itkRegistrationRunFolder.h"
 #include "morea/Error.h"
 #include "itkMOREAFail.h"
 
@@ -258,6 +262,28 @@ WriteOutputFiles(const MultiObjectiveRegistrationRun & run, const ::morea::Param
         << r.boundSampleLaterSeconds << "," << r.phaseSeconds.parentState << "\n";
   WriteTextFile(log.str(), out + "generations.csv");
 
+  // What looking at any front solution later needs (itkRegistrationRunFolder.h),
+  // and the front's and the convergence's plots.
+  WriteFrontMeshes(result.model.topology, result.front, out + FrontMeshesFileName);
+  WritePreprocessedProblem(problem, out + PreprocessedFolderName);
+  {
+    std::vector<std::array<double, 3>>               objectives;
+    std::vector<std::pair<std::size_t, std::string>> marked;
+    for (const auto & s : result.front)
+      objectives.push_back(s.fitness.objectives);
+    for (const auto & c : run.selected)
+      marked.emplace_back(c.choice.index, c.choice.label);
+    WriteFrontPlot(objectives, marked, out + "plot_front.png");
+    std::vector<double> generations, hypervolume, bestGuidance;
+    for (const auto & r : result.history)
+    {
+      generations.push_back(static_cast<double>(r.generation));
+      hypervolume.push_back(r.hypervolume);
+      bestGuidance.push_back(r.bestGuidance);
+    }
+    WriteConvergencePlot(generations, hypervolume, bestGuidance, out + "plot_convergence.png");
+  }
+
   // The chosen solutions.
   const bool       scored = !problem.structures.empty() || !problem.fixedLandmarks.empty();
   nlohmann::json   summary;
@@ -308,6 +334,9 @@ WriteOutputFiles(const MultiObjectiveRegistrationRun & run, const ::morea::Param
       RenderComparison(problem, fields.fixedToMoving, preprocessed.report.cropStructure, dir + "render");
       lap(renderSeconds);
     }
+    WriteSolutionPlots(SolutionSliceViews(problem, fields.fixedToMoving), c.label + " (solution " + std::to_string(s.id) + ")",
+                       dir + "plot");
+    lap(renderSeconds);
     summary["solutions"][c.label] = entry;
   }
   if (scored)

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // Surface elements of a binary mask on the grid of voxel corners, the
 // representation behind ComputeSurfaceDistances (private to the ITK layer).
 #ifndef itkSurfaceElements_h

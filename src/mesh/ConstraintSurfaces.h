@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration mesh generation (the mesh layer's own header):
 // structure surfaces made fit to constrain TetGen, and the constrained
 // tetrahedralisation that falls back to fewer surfaces, then none, when

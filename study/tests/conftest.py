@@ -1,3 +1,5 @@
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 """Fixtures of the study's tests: the morea binary and small synthetic problems."""
 from __future__ import annotations
 

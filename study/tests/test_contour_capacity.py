@@ -1,3 +1,5 @@
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 """The contour-capacity study's parts: it reads the meshes morea writes,
 carries points through the piecewise-affine map, and fits contour points onto
 a surface without folding a tetrahedron."""

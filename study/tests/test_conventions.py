@@ -1,3 +1,5 @@
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 """The competitors' outputs reach `morea evaluate` in its conventions:
 fixed_to_moving on the fixed grid maps x to x + u(x); moving_to_fixed on the
 moving grid is its inverse. Checked with a known translation, first through

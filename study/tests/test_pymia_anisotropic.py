@@ -1,3 +1,5 @@
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 """Cross-check of `morea evaluate`'s surface distances against pymia on irregular
 masks with anisotropic voxels. The random smooth blobs, speckle and scattered
 voxels hold nearly all of the 256 2x2x2 neighbourhood codes (all ambiguous and

@@ -1,3 +1,5 @@
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 """Cross-check of `morea evaluate`'s Dice, Hausdorff and 95th-percentile
 Hausdorff against pymia (the package the MOREA paper used) on the same masks:
 the phantom's structures, unregistered and after a whole-voxel translation

@@ -1,3 +1,5 @@
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 """`python -m study rescore`: the baseline and every finished run are scored
 again by `morea evaluate` without registering anything; the new scores replace
 the old ones in the tables, the run times stay those of run.json, and runs

@@ -1,3 +1,5 @@
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 # Bad inputs to the `morea` command line: each must exit non-zero, say what is
 # wrong on stderr, and leave no output behind that looks valid.
 #

@@ -1,3 +1,5 @@
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 # End-to-end test of the `morea` command line on the synthetic phantom:
 #   phantom -> preprocess -> evaluate (identity baseline, with renders),
 #   evaluate with the phantom's true fields, a TOML parameter file with a

@@ -1,3 +1,5 @@
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 # An output folder holds one run's whole result or says it does not: `morea
 # register` owns its folder while it runs, writes its outputs whole or not at
 # all (summary.json last), and a rerun clears what earlier runs left behind.

@@ -1,3 +1,5 @@
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 # docs/parameters.md ends with the table `morea parameters` prints: a key
 # added, removed or changed without the document following fails here.
 # Regenerate the table with `morea parameters` after the document's intro.

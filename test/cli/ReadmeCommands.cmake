@@ -1,3 +1,5 @@
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 # The `morea` commands of README.md's command-line section, run as written in
 # a scratch folder (registrations shortened to 3 generations), and the main
 # job of scripts/run-main.sh (`morea demo`), shortened the same way.

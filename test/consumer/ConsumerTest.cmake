@@ -1,3 +1,5 @@
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 # Installs this build into a temporary prefix, builds test/consumer (a
 # project of its own) against it with find_package, and runs the example it
 # builds on the phantom with the installed `morea`.

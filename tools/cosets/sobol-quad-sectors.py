@@ -1,4 +1,6 @@
 #!/usr/bin/env python3
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 """How many texture sectors each quad of 4 lanes touches when a warp's lanes
 take one coset of W (CosetBases in src/core/SampleCosets.cxx), and how many
 with the best choice of the two basis vectors of W that span a quad.

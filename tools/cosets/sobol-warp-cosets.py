@@ -1,4 +1,6 @@
 #!/usr/bin/env python3
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 """Finds the index subspaces W whose cosets the texture sampling kernel's lanes
 take in whole chunks of 512 samples (CosetBases in src/core/SampleCosets.cxx).
 

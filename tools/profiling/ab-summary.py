@@ -1,4 +1,6 @@
 #!/usr/bin/env python3
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 """Per program of a `run-device-benchmark.sh ab` run: mean seconds per
 generation and per phase over generations FIRST..LAST of its generations.csv.
 Usage: tools/profiling/ab-summary.py ABDIR FIRST LAST"""

@@ -1,4 +1,6 @@
 #!/usr/bin/env python3
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 """Where the device stands idle, from a timeline written by device-timeline.c.
 
   device-gaps.py TIMELINE [--from-seconds S] [--min-ms M] [--write-gaps FILE]

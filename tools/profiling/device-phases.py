@@ -1,4 +1,6 @@
 #!/usr/bin/env python3
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 """Summary of one run of a `morea benchmark` JSON (BACKEND, or the first): seconds per
 generation, and per generation the device phases (device_phase_seconds), the
 batch span, the backend's host time and the optimiser's phases.

@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 /* A timeline of one program's device work and CUDA runtime calls, for GPU
  * machines without Nsight Systems (those bench/run-device-benchmark.sh runs
  * on). Loaded with LD_PRELOAD; inactive unless MOREA_TIMELINE names the file

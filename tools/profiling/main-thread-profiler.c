@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 /* A sampling profiler of one program's main thread in wall-clock time, for
  * machines without perf or gdb (the GPU machines bench/run-device-benchmark.sh
  * runs on). Loaded with LD_PRELOAD; inactive unless MOREA_PROFILE names the

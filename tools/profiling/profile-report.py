@@ -1,4 +1,6 @@
 #!/usr/bin/env python3
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 """Names the functions in a profile written by main-thread-profiler.c.
 
   profile-report.py PROFILE [--binary PATH]... [--under TEXT] [--callers-of TEXT] [--skip FRACTION] [--top N]

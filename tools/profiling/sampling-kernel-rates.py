@@ -1,4 +1,6 @@
 #!/usr/bin/env python3
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 """Sampled points per second by kernel, from a device timeline.
 
 `morea benchmark` reports samples per second over its sampling kernels'

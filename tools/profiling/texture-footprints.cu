@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // Filtered fetches per second of the texel formats the sampling kernel could
 // use, as a warp's 32 lanes spread over cubes of growing edge: how much a
 // format and the lanes' spread cost on this GPU, apart from the rest of the

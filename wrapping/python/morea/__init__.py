@@ -1,3 +1,5 @@
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 """MOREA: multi-objective deformable registration of 3D images with large
 deformations, on the GPU when one is present.
 
@@ -20,7 +22,15 @@ from ._results import RegistrationResult, Solution
 from ._tools import evaluate, phantom, preprocess, read_rtstruct
 
 __all__ = ["register", "preprocess", "evaluate", "phantom", "read_rtstruct", "Image", "RegistrationResult",
-           "Solution"]
+           "Solution", "batch"]
+
+
+def batch(cohort, output=None, **options):
+    """Runs a cohort of registrations (a CSV table or a list of dicts, one
+    registration per row) on Dask; see morea.cohort.batch for the options."""
+    from .cohort import batch as run_batch
+
+    return run_batch(cohort, output, **options)
 
 
 def _progress_bar(enabled):

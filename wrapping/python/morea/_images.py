@@ -1,3 +1,5 @@
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 """Images and point sets in and out: SimpleITK, itk and numpy.
 
 Inside, an image is a C-ordered (z, y, x) numpy array with its geometry

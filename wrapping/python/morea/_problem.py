@@ -1,3 +1,5 @@
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 """A registration problem from Python's images, masks and points, handed to
 the filter behind morea._morea.Registration."""
 import os

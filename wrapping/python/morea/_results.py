@@ -1,3 +1,5 @@
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 """What morea.register returns: the front, its solutions and their transforms."""
 import json
 import os

@@ -1,3 +1,5 @@
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 """The steps around a registration: preprocessing, scoring, the phantom and
 RTSTRUCT contours, each on the library's own code."""
 import json

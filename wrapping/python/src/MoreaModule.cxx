@@ -1,3 +1,5 @@
+// Copyright 2026 The MultiObjectiveRegistration authors
+// SPDX-License-Identifier: Apache-2.0
 // The Python binding (module morea._morea): one registration through
 // itk::MultiObjectiveMeshRegistrationFilter on numpy arrays with their
 // geometry. The package (wrapping/python/morea) turns SimpleITK, itk and
@@ -10,6 +12,8 @@
 #include "itkRTStructureSetIO.h"
 #include "itkRegistrationEvaluation.h"
 #include "itkRegistrationOutputs.h"
+#include "itkRegistrationPlots.h"
+#include "itkRegistrationRunFolder.h"
 #include "morea/Error.h"
 #include "morea/OutputFolderLock.h"
 
@@ -20,7 +24,10 @@
 
 #include <array>
 #include <atomic>
+#include <list>
 #include <map>
+#include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -590,6 +597,174 @@ private:
   FilterType::Pointer    m_Filter;
   std::vector<py::array> m_Keep; ///< the arrays the input images read
 };
+
+/** A finished run's folder read back (itkRegistrationRunFolder.h), for the
+ *  front navigator: any front solution rasterised on demand, its slices as
+ *  PNG, its scores, and its export into the run's folder. Thread-safe. */
+class SavedRun
+{
+public:
+  explicit SavedRun(const std::string & folder)
+  {
+    py::gil_scoped_release release;
+    m_Run = UserCall([&] { return itk::morea::ReadRunFolder(folder); });
+    m_Baseline = std::make_shared<itk::morea::SolutionSliceViews>(m_Run.problem, nullptr);
+  }
+
+  std::string
+  Folder() const
+  {
+    return m_Run.folder;
+  }
+
+  /** Per front solution: (id, magnitude, intensity, guidance, constraint, chosen labels). */
+  std::vector<std::tuple<std::uint64_t, double, double, double, double, std::string>>
+  Front() const
+  {
+    std::vector<std::tuple<std::uint64_t, double, double, double, double, std::string>> out;
+    for (std::size_t i = 0; i < m_Run.front.size(); ++i)
+    {
+      const auto & f = m_Run.front[i].fitness;
+      out.emplace_back(m_Run.front[i].id, f.objectives[0], f.objectives[1], f.objectives[2], f.constraint,
+                       m_Run.chosen[i]);
+    }
+    return out;
+  }
+
+  std::string
+  Summary() const
+  {
+    return m_Run.summary.dump();
+  }
+
+  /** Voxels along x, y, z; the structure the slices go through by default and
+   *  its slices (sagittal, coronal, axial); the structures in colour order. */
+  py::dict
+  Layout() const
+  {
+    py::dict out;
+    out["size"] = m_Baseline->Size();
+    out["focus"] = m_Baseline->FocusStructure();
+    py::dict slices;
+    for (const auto axis : { itk::morea::SliceAxis::Axial, itk::morea::SliceAxis::Coronal, itk::morea::SliceAxis::Sagittal })
+      slices[itk::morea::SliceAxisName(axis)] = m_Baseline->FocusSlice(axis);
+    out["focus_slices"] = slices;
+    out["structures"] = m_Baseline->StructureNames();
+    std::vector<std::string> colors;
+    for (std::size_t i = 0; i < m_Baseline->StructureNames().size(); ++i)
+    {
+      const auto c = itk::morea::StructureColor(i);
+      char       hex[8];
+      std::snprintf(hex, sizeof hex, "#%02x%02x%02x", c[0], c[1], c[2]);
+      colors.emplace_back(hex);
+    }
+    out["colors"] = colors;
+    const auto & spacing = m_Run.problem.fixedImage->GetSpacing();
+    out["spacing"] = std::array<double, 3>{ { spacing[0], spacing[1], spacing[2] } };
+    return out;
+  }
+
+  /** Solution `index`'s slice as PNG bytes, `width` pixels across the widest
+   *  slice; index -1: before registration (identity). */
+  py::bytes
+  SlicePng(long index, const std::string & axis, long slice, const std::string & view, bool contours, int width)
+  {
+    std::string png;
+    {
+      py::gil_scoped_release release;
+      png = UserCall([&] {
+        const auto views = ViewsOf(index);
+        if (width < 64 || width > 2048)
+          throw ::morea::Error("the slice width must be 64 to 2048 pixels");
+        return views
+          ->Render(itk::morea::SliceAxisFromName(axis), slice, itk::morea::SliceViewFromName(view), contours,
+                   views->PixelsPerMmForWidth(width))
+          .EncodePng();
+      });
+    }
+    return py::bytes(png);
+  }
+
+  /** Solution `index` scored on the preprocessed problem, JSON text. */
+  std::string
+  Scores(long index)
+  {
+    py::gil_scoped_release release;
+    return UserCall([&] {
+      const auto entry = Entry(index);
+      std::lock_guard<std::mutex> lock(entry->mutex);
+      if (entry->scores.empty())
+      {
+        nlohmann::json scores;
+        if (!m_Run.problem.structures.empty() || !m_Run.problem.fixedLandmarks.empty())
+          scores = itk::morea::ScoresToJson(itk::morea::EvaluateRegistration(
+            m_Run.problem, entry->fields.fixedToMoving, entry->fields.movingToFixed,
+            m_Run.parameters.GetReal("evaluation_border_margin")));
+        const auto [jmin, jmax] = entry->views->JacobianRange();
+        scores["jacobian_min"] = jmin;
+        scores["jacobian_max"] = jmax;
+        entry->scores = scores.dump();
+      }
+      return entry->scores;
+    });
+  }
+
+  /** Writes solution `index` into RUN/solution_<id>/; returns that folder. */
+  std::string
+  Export(long index)
+  {
+    py::gil_scoped_release release;
+    return UserCall([&] {
+      const auto entry = Entry(index);
+      return itk::morea::ExportSavedSolution(m_Run, static_cast<std::size_t>(index), entry->fields);
+    });
+  }
+
+private:
+  struct Cached
+  {
+    std::mutex                                           mutex; ///< guards scores
+    itk::morea::MeshFields                               fields;
+    std::shared_ptr<const itk::morea::SolutionSliceViews> views;
+    std::string                                          scores;
+  };
+
+  std::shared_ptr<const itk::morea::SolutionSliceViews>
+  ViewsOf(long index)
+  {
+    if (index == -1)
+      return m_Baseline;
+    return Entry(index)->views;
+  }
+
+  /** Solution `index` rasterised (the last few are kept). */
+  std::shared_ptr<Cached>
+  Entry(long index)
+  {
+    if (index < 0 || static_cast<std::size_t>(index) >= m_Run.front.size())
+      throw ::morea::Error("solution " + std::to_string(index) + " is not in the front of " +
+                           std::to_string(m_Run.front.size()));
+    std::lock_guard<std::mutex> lock(m_Mutex); // one rasterisation at a time
+    for (auto it = m_Cache.begin(); it != m_Cache.end(); ++it)
+      if (it->first == index)
+      {
+        m_Cache.splice(m_Cache.begin(), m_Cache, it);
+        return it->second;
+      }
+    auto entry = std::make_shared<Cached>();
+    entry->fields = itk::morea::RasterizeSavedSolution(m_Run, static_cast<std::size_t>(index));
+    entry->views = std::make_shared<itk::morea::SolutionSliceViews>(m_Run.problem, entry->fields.fixedToMoving);
+    m_Cache.emplace_front(index, entry);
+    if (m_Cache.size() > 6)
+      m_Cache.pop_back();
+    return entry;
+  }
+
+  itk::morea::SavedRegistrationRun                         m_Run;
+  std::shared_ptr<const itk::morea::SolutionSliceViews>    m_Baseline;
+  std::mutex                                               m_Mutex;
+  std::list<std::pair<long, std::shared_ptr<Cached>>>      m_Cache;
+};
 } // namespace
 
 PYBIND11_MODULE(_morea, m)
@@ -648,6 +823,16 @@ PYBIND11_MODULE(_morea, m)
       return out;
     },
     py::arg("path"), py::arg("size"), py::arg("geometry"), py::arg("names"));
+  py::class_<SavedRun>(m, "SavedRun")
+    .def(py::init<const std::string &>(), py::arg("folder"))
+    .def_property_readonly("folder", &SavedRun::Folder)
+    .def("front", &SavedRun::Front)
+    .def("summary", &SavedRun::Summary)
+    .def("layout", &SavedRun::Layout)
+    .def("slice_png", &SavedRun::SlicePng, py::arg("index"), py::arg("axis"), py::arg("slice"), py::arg("view"),
+         py::arg("contours"), py::arg("width"))
+    .def("scores", &SavedRun::Scores, py::arg("index"))
+    .def("export", &SavedRun::Export, py::arg("index"));
   py::class_<Registration>(m, "Registration")
     .def(py::init<>())
     .def("set_images", &Registration::SetImages)

@@ -1,3 +1,5 @@
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 """The pelvis phantom (written by `morea phantom`, MOREA_BIN) shared by the tests."""
 import os
 import subprocess

@@ -1,4 +1,6 @@
 #!/usr/bin/env bash
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 # run-pytest.sh PYTHON TESTS_DIR: pytest on the package, or exit 77 (skipped)
 # when the interpreter lacks numpy, SimpleITK or pytest.
 set -euo pipefail

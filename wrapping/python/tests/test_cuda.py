@@ -1,3 +1,5 @@
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 """morea.register with backend="auto" on a machine with a CUDA device: the
 GPU runs it, and the registration improves the phantom. Skips without a
 device. Needs numpy only, so it also runs as a script where pytest and

@@ -1,3 +1,5 @@
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 """morea.register on the pelvis phantom (written by `morea phantom`, MOREA_BIN)."""
 import csv
 import os

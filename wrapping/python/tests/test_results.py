@@ -1,3 +1,5 @@
+# Copyright 2026 The MultiObjectiveRegistration authors
+# SPDX-License-Identifier: Apache-2.0
 """What a RegistrationResult gives: saved folders, scores, transforms for
 SimpleITK and itk, and the steps around a registration."""
 import json
