@@ -117,6 +117,15 @@ private:
            const LabelMapReader & readLabels) const;
 };
 
+/** Writes `problem` as a problem folder that `--problem` reads: fixed and
+ *  moving images, fixed_masks/, moving_masks/, fixed_points/ and
+ *  moving_points/ (CSV), body masks and landmarks, images and masks with
+ *  `imageExtension` (".nii.gz"; ".mha" keeps the grids' geometry exact in
+ *  double precision). */
+void
+WriteProblemFolder(const RegistrationProblem & problem, const std::string & folder,
+                   const std::string & imageExtension = ".nii.gz");
+
 } // namespace morea
 } // namespace itk
 

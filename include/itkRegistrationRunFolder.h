@@ -39,11 +39,10 @@ void
 WriteFrontMeshes(const ::morea::MeshTopology & topology, const std::vector<FrontSolution> & front,
                  const std::string & path);
 
-/** Writes a preprocessed problem as a problem folder that `--problem`
- *  reads too (fixed.mha, moving.mha, fixed_masks/, moving_masks/, body
- *  masks, landmarks; MetaImage keeps the grids' geometry exact) plus
- *  problem.json (the structures in order). Contour points are left out:
- *  looking at solutions needs the masks only. */
+/** Writes a preprocessed problem as a problem folder (WriteProblemFolder
+ *  with MetaImage, which keeps the grids' geometry exact) plus problem.json
+ *  (the structures in order). Reading it back for a solution's scores takes
+ *  the masks only. */
 void
 WritePreprocessedProblem(const RegistrationProblem & problem, const std::string & folder);
 

@@ -162,35 +162,6 @@ ParameterOptions::Load() const
 }
 
 void
-WriteProblemFolder(const itk::morea::RegistrationProblem & problem, const std::string & folder)
-{
-  using namespace itk::morea;
-  const fs::path root(folder);
-  WriteImage(problem.fixedImage, (root / "fixed.nii.gz").string());
-  WriteImage(problem.movingImage, (root / "moving.nii.gz").string());
-  for (const auto & s : problem.structures)
-  {
-    if (s.fixedMask)
-      WriteMask(s.fixedMask, (root / "fixed_masks" / (s.name + ".nii.gz")).string());
-    if (s.movingMask)
-      WriteMask(s.movingMask, (root / "moving_masks" / (s.name + ".nii.gz")).string());
-    if (!s.fixedPoints.empty())
-      WriteLandmarksCsv(s.fixedPoints, (root / "fixed_points" / (s.name + ".csv")).string());
-    if (!s.movingPoints.empty())
-      WriteLandmarksCsv(s.movingPoints, (root / "moving_points" / (s.name + ".csv")).string());
-  }
-  if (problem.fixedBodyMask)
-    WriteMask(problem.fixedBodyMask, (root / "fixed_body.nii.gz").string());
-  if (problem.movingBodyMask)
-    WriteMask(problem.movingBodyMask, (root / "moving_body.nii.gz").string());
-  if (!problem.fixedLandmarks.empty())
-  {
-    WriteElastixPointFile(problem.fixedLandmarks, (root / "fixed_landmarks.txt").string());
-    WriteElastixPointFile(problem.movingLandmarks, (root / "moving_landmarks.txt").string());
-  }
-}
-
-void
 PrintScores(std::ostream & out, const itk::morea::EvaluationScores & scores, const std::string & title)
 {
   char line[256];

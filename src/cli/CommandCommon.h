@@ -51,12 +51,6 @@ struct ParameterOptions
   Load() const;
 };
 
-/** Writes a problem in the folder layout that ProblemOptions::folder reads:
- *  fixed.nii.gz, moving.nii.gz, fixed_masks/NAME.nii.gz, moving_masks/NAME.nii.gz,
- *  fixed_points/NAME.csv, moving_points/NAME.csv, fixed_body.nii.gz,
- *  moving_body.nii.gz, fixed_landmarks.txt, moving_landmarks.txt. */
-void
-WriteProblemFolder(const itk::morea::RegistrationProblem & problem, const std::string & folder);
 
 /** Splits "NAME=VALUE"; throws naming `what` when there is no '='. */
 std::pair<std::string, std::string>

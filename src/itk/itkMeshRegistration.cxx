@@ -226,9 +226,15 @@ RegisterMeshes(const RegistrationProblem & problem, const ::morea::ParameterSet 
       else
       {
         if (level == 0)
-          optimiser.Initialize(::morea::GenerateInitialPopulation(
+        {
+          auto population = ::morea::GenerateInitialPopulation(
             model.base, constraint, gomea.populationSize, gomea.seed,
-            ::morea::InitialPopulationOptions::FromParameters(parameters)));
+            ::morea::InitialPopulationOptions::FromParameters(parameters));
+          // Rigid structures start within their strain limit.
+          for (auto & solution : population)
+            ::morea::ScaleIntoStrainLimit(model.rigidity, model.base, solution);
+          optimiser.Initialize(std::move(population));
+        }
         else
           optimiser.Initialize(std::move(carriedPopulation), carriedArchive);
         // Later levels' files are another run's now: a resume must not take them.

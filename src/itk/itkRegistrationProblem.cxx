@@ -446,5 +446,33 @@ RegistrationProblem::Validate() const
       Fail("the fixed and moving images do not overlap in physical space");
 }
 
+void
+WriteProblemFolder(const RegistrationProblem & problem, const std::string & folder, const std::string & imageExtension)
+{
+  const std::filesystem::path root(folder);
+  WriteImage(problem.fixedImage, (root / ("fixed" + imageExtension)).string());
+  WriteImage(problem.movingImage, (root / ("moving" + imageExtension)).string());
+  for (const auto & s : problem.structures)
+  {
+    if (s.fixedMask)
+      WriteMask(s.fixedMask, (root / "fixed_masks" / (s.name + imageExtension)).string());
+    if (s.movingMask)
+      WriteMask(s.movingMask, (root / "moving_masks" / (s.name + imageExtension)).string());
+    if (!s.fixedPoints.empty())
+      WriteLandmarksCsv(s.fixedPoints, (root / "fixed_points" / (s.name + ".csv")).string());
+    if (!s.movingPoints.empty())
+      WriteLandmarksCsv(s.movingPoints, (root / "moving_points" / (s.name + ".csv")).string());
+  }
+  if (problem.fixedBodyMask)
+    WriteMask(problem.fixedBodyMask, (root / ("fixed_body" + imageExtension)).string());
+  if (problem.movingBodyMask)
+    WriteMask(problem.movingBodyMask, (root / ("moving_body" + imageExtension)).string());
+  if (!problem.fixedLandmarks.empty())
+  {
+    WriteElastixPointFile(problem.fixedLandmarks, (root / "fixed_landmarks.txt").string());
+    WriteElastixPointFile(problem.movingLandmarks, (root / "moving_landmarks.txt").string());
+  }
+}
+
 } // namespace morea
 } // namespace itk

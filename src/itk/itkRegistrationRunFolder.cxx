@@ -127,30 +127,11 @@ WriteFrontMeshes(const ::morea::MeshTopology & topology, const std::vector<Front
 void
 WritePreprocessedProblem(const RegistrationProblem & problem, const std::string & folder)
 {
-  const fs::path root(folder);
-  WriteImage(problem.fixedImage, (root / "fixed.mha").string());
-  WriteImage(problem.movingImage, (root / "moving.mha").string());
+  WriteProblemFolder(problem, folder, ".mha");
   nlohmann::json structures = nlohmann::json::array();
   for (const auto & s : problem.structures)
-  {
-    if (s.name.empty() || s.name.find_first_of("/\\") != std::string::npos || s.name[0] == '.')
-      continue; // not a file name; such names are refused on input anyway
-    if (s.fixedMask)
-      WriteMask(s.fixedMask, (root / "fixed_masks" / (s.name + ".mha")).string());
-    if (s.movingMask)
-      WriteMask(s.movingMask, (root / "moving_masks" / (s.name + ".mha")).string());
     structures.push_back({ { "name", s.name }, { "fixed_mask", bool(s.fixedMask) }, { "moving_mask", bool(s.movingMask) } });
-  }
-  if (problem.fixedBodyMask)
-    WriteMask(problem.fixedBodyMask, (root / "fixed_body.mha").string());
-  if (problem.movingBodyMask)
-    WriteMask(problem.movingBodyMask, (root / "moving_body.mha").string());
-  if (!problem.fixedLandmarks.empty())
-  {
-    WriteElastixPointFile(problem.fixedLandmarks, (root / "fixed_landmarks.txt").string());
-    WriteElastixPointFile(problem.movingLandmarks, (root / "moving_landmarks.txt").string());
-  }
-  WriteTextFile(nlohmann::json{ { "structures", structures } }.dump(2) + "\n", (root / "problem.json").string());
+  WriteTextFile(nlohmann::json{ { "structures", structures } }.dump(2) + "\n", (fs::path(folder) / "problem.json").string());
 }
 
 void
