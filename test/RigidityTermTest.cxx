@@ -8,7 +8,6 @@
 #include "morea/Error.h"
 #include "morea/ParameterSet.h"
 #include "morea/RigidityTerm.h"
-#include "morea/TetrahedronObjectives.h"
 #include "morea/RunFingerprint.h"
 
 #include <gtest/gtest.h>
@@ -179,40 +178,6 @@ TEST(RigidityTerm, TheStrainLimitViolatesLikeAFoldOnlyBeyondItAndOnlyInsideRigid
     p[0] *= 1.5;
   EXPECT_EQ(TetrahedronRigidViolation(model, 7, s, stretched, violated), 0.0);
   EXPECT_EQ(violated, 1.0);
-}
-
-TEST(RigidityTerm, InitialSolutionsAreScaledIntoTheStrainLimit)
-{
-  const TetrahedralMesh     mesh = Box();
-  const std::vector<double> all(mesh.NumberOfTetrahedra(), 1.0);
-  const RigidityModel       model = BuildRigidityModel(mesh, all, 10.0, 0.05);
-  const auto within = [&](const DualMesh & s) {
-    double violated = 0.0;
-    for (std::size_t t = 0; t < mesh.NumberOfTetrahedra(); ++t)
-      TetrahedronRigidViolation(model, t, CornersOf(mesh.tetrahedra[t], s.source), CornersOf(mesh.tetrahedra[t], s.target),
-                                violated);
-    return violated == 0.0;
-  };
-  // A 20 % stretch of the target: scaled back to within 5 % strain.
-  DualMesh stretched = DualMesh::FromBase(mesh);
-  for (auto & p : stretched.target)
-    p[0] *= 1.2;
-  ASSERT_FALSE(within(stretched));
-  const double factor = ScaleIntoStrainLimit(model, mesh, stretched);
-  EXPECT_GT(factor, 0.0);
-  EXPECT_LT(factor, 1.0);
-  EXPECT_TRUE(within(stretched));
-  // Within it already, or without a limit: unchanged.
-  DualMesh moved = DualMesh::FromBase(mesh);
-  for (auto & p : moved.target)
-    p = RigidMotion(p, 0.4, { { 1.0, 2.0, 3.0 } });
-  const DualMesh before = moved;
-  EXPECT_EQ(ScaleIntoStrainLimit(model, mesh, moved), 1.0);
-  EXPECT_EQ(moved.target, before.target);
-  DualMesh again = DualMesh::FromBase(mesh);
-  for (auto & p : again.target)
-    p[0] *= 1.2;
-  EXPECT_EQ(ScaleIntoStrainLimit(BuildRigidityModel(mesh, all, 10.0), mesh, again), 1.0);
 }
 
 TEST(RigidityTerm, FlatTetrahedraSquashedAcrossTheirThinSideCostMoreThanTheirEdgesChange)

@@ -72,14 +72,6 @@ double
 TetrahedronRigidViolation(const RigidityModel & model, std::size_t t, const std::array<Vec3, 4> & source,
                           const std::array<Vec3, 4> & target, double & violated);
 
-/** Moves `solution` towards `base` (both meshes, by one factor halved
- *  until it fits) until no tetrahedron exceeds the strain limit; returns the
- *  factor kept (1: unchanged; 0: the base itself, which always fits). So
- *  that an initial population starts within the limit rather than all of it
- *  violating the constraint. */
-double
-ScaleIntoStrainLimit(const RigidityModel & model, const TetrahedralMesh & base, DualMesh & solution);
-
 /** Whether a structure's name says it is bone: bone(s), femur, femoral head,
  *  pelvic bone, sacrum, vertebra, spine, skull, rib (any case, any separator). */
 bool

@@ -4,7 +4,6 @@
 
 #include "morea/Error.h"
 #include "morea/ParameterSet.h"
-#include "morea/TetrahedronObjectives.h"
 
 #include <algorithm>
 #include <cctype>
@@ -140,42 +139,6 @@ TetrahedronRigidViolation(const RigidityModel & model, std::size_t t, const std:
     return 0.0;
   violated += 1.0;
   return (deviation - model.strainLimitSquared) * model.limitVolumes[t];
-}
-
-double
-ScaleIntoStrainLimit(const RigidityModel & model, const TetrahedralMesh & base, DualMesh & solution)
-{
-  if (model.limitVolumes.empty())
-    return 1.0;
-  const auto within = [&](const DualMesh & s) {
-    for (std::size_t t = 0; t < base.tetrahedra.size(); ++t)
-    {
-      if (model.limitVolumes[t] == 0.0)
-        continue;
-      double violated = 0.0;
-      TetrahedronRigidViolation(model, t, CornersOf(base.tetrahedra[t], s.source), CornersOf(base.tetrahedra[t], s.target),
-                                violated);
-      if (violated > 0.0)
-        return false;
-    }
-    return true;
-  };
-  if (within(solution))
-    return 1.0;
-  const DualMesh original = solution;
-  for (double factor = 0.5; factor > 1e-3; factor *= 0.5)
-  {
-    for (std::size_t p = 0; p < base.points.size(); ++p)
-      for (int a = 0; a < 3; ++a)
-      {
-        solution.source[p][a] = base.points[p][a] + factor * (original.source[p][a] - base.points[p][a]);
-        solution.target[p][a] = base.points[p][a] + factor * (original.target[p][a] - base.points[p][a]);
-      }
-    if (within(solution))
-      return factor;
-  }
-  solution = DualMesh::FromBase(base);
-  return 0.0;
 }
 
 bool

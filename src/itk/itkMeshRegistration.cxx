@@ -226,15 +226,9 @@ RegisterMeshes(const RegistrationProblem & problem, const ::morea::ParameterSet 
       else
       {
         if (level == 0)
-        {
-          auto population = ::morea::GenerateInitialPopulation(
+          optimiser.Initialize(::morea::GenerateInitialPopulation(
             model.base, constraint, gomea.populationSize, gomea.seed,
-            ::morea::InitialPopulationOptions::FromParameters(parameters));
-          // Rigid structures start within their strain limit.
-          for (auto & solution : population)
-            ::morea::ScaleIntoStrainLimit(model.rigidity, model.base, solution);
-          optimiser.Initialize(std::move(population));
-        }
+            ::morea::InitialPopulationOptions::FromParameters(parameters)));
         else
           optimiser.Initialize(std::move(carriedPopulation), carriedArchive);
         // Later levels' files are another run's now: a resume must not take them.
