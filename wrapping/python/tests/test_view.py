@@ -24,7 +24,10 @@ from morea import view
 
 PNG = b"\x89PNG\r\n\x1a\n"
 # A run with a front of a few distinct solutions, still small.
-PARAMETERS = dict(TINY, ea_num_generations=8)
+# The page's test needs front members whose slices differ. In so short a run,
+# the rigid strain limit keeps most of the population near its start (it
+# violates the limit at first), so the limit is off here.
+PARAMETERS = dict(TINY, ea_num_generations=8, morea_rigid_strain_limit=0.0)
 
 
 @pytest.fixture(scope="module")
