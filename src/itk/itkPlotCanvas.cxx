@@ -140,15 +140,27 @@ PlotCanvas::Circle(double cx, double cy, double radius, RGB color, bool filled, 
     }
 }
 
+namespace
+{
+/** The font's glyph for `ch` ('?' for characters it lacks), and in `drop`
+ *  the rows a descender lowers it by. */
+const auto &
+GlyphOf(char ch, int & drop)
+{
+  const int c = static_cast<unsigned char>(ch);
+  drop = font::HasDescender(static_cast<char>(c)) ? 2 : 0;
+  return font::Glyphs[(c >= 32 && c <= 126) ? c - 32 : '?' - 32];
+}
+} // namespace
+
 int
 PlotCanvas::Text(int x, int y, const std::string & text, RGB color, int scale)
 {
   int pen = x;
   for (const char ch : text)
   {
-    const int    c = static_cast<unsigned char>(ch);
-    const auto & glyph = font::Glyphs[(c >= 32 && c <= 126) ? c - 32 : '?' - 32];
-    const int    drop = font::HasDescender(static_cast<char>(c)) ? 2 : 0;
+    int          drop = 0;
+    const auto & glyph = GlyphOf(ch, drop);
     for (int row = 0; row < font::GlyphHeight; ++row)
       for (int col = 0; col < font::GlyphWidth; ++col)
         if (glyph[row][col] == '#')
@@ -164,9 +176,8 @@ PlotCanvas::TextVertical(int x, int y, const std::string & text, RGB color, int 
   int pen = y;
   for (const char ch : text)
   {
-    const int    c = static_cast<unsigned char>(ch);
-    const auto & glyph = font::Glyphs[(c >= 32 && c <= 126) ? c - 32 : '?' - 32];
-    const int    drop = font::HasDescender(static_cast<char>(c)) ? 2 : 0;
+    int          drop = 0;
+    const auto & glyph = GlyphOf(ch, drop);
     // Column `col` of the glyph runs upwards from the pen; row `row` goes right.
     for (int row = 0; row < font::GlyphHeight; ++row)
       for (int col = 0; col < font::GlyphWidth; ++col)
