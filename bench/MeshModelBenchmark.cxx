@@ -4,13 +4,13 @@
 // 700) on the phantom: mesh generation, parallel structure, initial
 // population, fold evaluation and rasterisation. A plain timed program: run it
 // on an otherwise idle machine and record its output with the machine's name.
-#include "morea/FoldConstraint.h"
-#include "morea/InitialPopulation.h"
-#include "morea/MeshGenerator.h"
-#include "morea/MeshPointPlacement.h"
-#include "morea/MeshRasterizer.h"
-#include "morea/ParallelStructure.h"
-#include "morea/Phantom.h"
+#include "morea_core/FoldConstraint.h"
+#include "morea_core/InitialPopulation.h"
+#include "morea_core/MeshGenerator.h"
+#include "morea_core/MeshPointPlacement.h"
+#include "morea_core/MeshRasterizer.h"
+#include "morea_core/ParallelStructure.h"
+#include "morea_core/Phantom.h"
 
 #include <algorithm>
 #include <chrono>
@@ -32,51 +32,51 @@ int
 main()
 {
   std::printf("threads: %u\n", std::thread::hardware_concurrency());
-  morea::PhantomOptions phantomOptions;
+  morea_core::PhantomOptions phantomOptions;
   phantomOptions.spacing = 1.5;
   auto       start = Clock::now();
-  const auto phantom = morea::PelvisPhantom(phantomOptions).Generate();
+  const auto phantom = morea_core::PelvisPhantom(phantomOptions).Generate();
   std::printf("phantom at 1.5 mm: %zu voxels, %.3f s\n", phantom.fixedImage.NumberOfVoxels(), Seconds(start));
 
   // The domain: the bladder's bounding box plus 30 mm, as preprocessing crops.
-  const auto & names = morea::PelvisPhantom::StructureNames();
-  morea::Vec3  lo{ { 1e9, 1e9, 1e9 } }, hi{ { -1e9, -1e9, -1e9 } };
-  for (const auto & p : morea::MaskBoundaryPoints(phantom.movingMasks[2]))
+  const auto & names = morea_core::PelvisPhantom::StructureNames();
+  morea_core::Vec3  lo{ { 1e9, 1e9, 1e9 } }, hi{ { -1e9, -1e9, -1e9 } };
+  for (const auto & p : morea_core::MaskBoundaryPoints(phantom.movingMasks[2]))
     for (int a = 0; a < 3; ++a)
     {
       lo[a] = std::min(lo[a], p[a]);
       hi[a] = std::max(hi[a], p[a]);
     }
-  const auto        full = morea::MeshDomain::OfGrid(phantom.movingImage);
-  morea::MeshDomain domain;
+  const auto        full = morea_core::MeshDomain::OfGrid(phantom.movingImage);
+  morea_core::MeshDomain domain;
   for (int a = 0; a < 3; ++a)
   {
     domain.lower[a] = std::max(full.lower[a], lo[a] - 30.0);
     domain.upper[a] = std::min(full.upper[a], hi[a] + 30.0);
   }
-  std::vector<morea::MeshStructure> structures;
+  std::vector<morea_core::MeshStructure> structures;
   start = Clock::now();
   for (std::size_t s = 1; s < names.size(); ++s)
-    structures.push_back({ names[s], morea::MaskBoundaryPoints(phantom.movingMasks[s]), &phantom.movingMasks[s] });
+    structures.push_back({ names[s], morea_core::MaskBoundaryPoints(phantom.movingMasks[s]), &phantom.movingMasks[s] });
   std::printf("contour points: %.3f s\n", Seconds(start));
 
-  morea::MeshGenerationReport report;
+  morea_core::MeshGenerationReport report;
   start = Clock::now();
-  const auto mesh = morea::GenerateMesh(domain, structures, morea::MeshGeneratorOptions{}, &report);
+  const auto mesh = morea_core::GenerateMesh(domain, structures, morea_core::MeshGeneratorOptions{}, &report);
   std::printf("mesh: %zu points, %zu tetrahedra, %zu slivers; %.3f s (surfaces %.3f, placement %.3f, TetGen and "
               "sliver removal %.3f)\n",
               mesh.NumberOfPoints(), mesh.NumberOfTetrahedra(), report.slivers, Seconds(start), report.secondsSurfaces,
               report.secondsPlacement, report.secondsTetrahedralization);
 
   start = Clock::now();
-  const morea::MeshTopology topology(mesh.tetrahedra, mesh.NumberOfPoints());
-  const auto                parallel = morea::BuildParallelStructure(topology);
+  const morea_core::MeshTopology topology(mesh.tetrahedra, mesh.NumberOfPoints());
+  const auto                parallel = morea_core::BuildParallelStructure(topology);
   std::printf("topology and parallel structure: %zu FOS elements, %zu groups, %.4f s\n", parallel.elements.size(),
               parallel.groups.size(), Seconds(start));
 
-  const morea::FoldConstraint constraint(topology, mesh.points);
+  const morea_core::FoldConstraint constraint(topology, mesh.points);
   start = Clock::now();
-  const auto population = morea::GenerateInitialPopulation(mesh, constraint, 700, 1);
+  const auto population = morea_core::GenerateInitialPopulation(mesh, constraint, 700, 1);
   std::printf("initial population of 700: %.3f s\n", Seconds(start));
 
   start = Clock::now();
@@ -90,9 +90,9 @@ main()
   std::array<std::size_t, 3> size{};
   for (int a = 0; a < 3; ++a)
     size[a] = static_cast<std::size_t>((domain.upper[a] - domain.lower[a]) / 1.5) + 1;
-  morea::Volume<morea::Vec3> field(size, { { 1.5, 1.5, 1.5 } }, domain.lower);
+  morea_core::Volume<morea_core::Vec3> field(size, { { 1.5, 1.5, 1.5 } }, domain.lower);
   start = Clock::now();
-  morea::RasterizeDisplacement(topology, population[1].target, population[1].source, field);
+  morea_core::RasterizeDisplacement(topology, population[1].target, population[1].source, field);
   std::printf("rasterisation on %zux%zux%zu voxels: %.3f s\n", size[0], size[1], size[2], Seconds(start));
   return feasible == population.size() ? 0 : 1;
 }

@@ -13,15 +13,15 @@
 
 #include "itkMeshTransforms.h"
 #include "itkRegistrationProblem.h"
-#include "morea/MeshGenerator.h"
-#include "morea/MeshRefinement.h"
-#include "morea/ParallelStructure.h"
-#include "morea/RigidityTerm.h"
+#include "morea_core/MeshGenerator.h"
+#include "morea_core/MeshRefinement.h"
+#include "morea_core/ParallelStructure.h"
+#include "morea_core/RigidityTerm.h"
 
 #include <string>
 #include <vector>
 
-namespace morea
+namespace morea_core
 {
 class ParameterSet;
 }
@@ -32,7 +32,7 @@ namespace morea
 {
 struct MeshModelReport
 {
-  ::morea::MeshGenerationReport generation;
+  morea_core::MeshGenerationReport generation;
   std::size_t                   fosElements{ 0 };
   std::size_t                   parallelGroups{ 0 };
   double                        secondsContourPoints{ 0.0 };
@@ -44,11 +44,11 @@ struct MeshModelReport
 struct MeshModel
 {
   DomainFrame                     frame;
-  ::morea::TetrahedralMesh        base;
-  ::morea::MeshTopology           topology;
-  ::morea::ParallelStructure      parallel;
+  morea_core::TetrahedralMesh        base;
+  morea_core::MeshTopology           topology;
+  morea_core::ParallelStructure      parallel;
   std::vector<double>             elasticity;      ///< per tetrahedron
-  ::morea::RigidityModel          rigidity;        ///< empty without rigid structures
+  morea_core::RigidityModel          rigidity;        ///< empty without rigid structures
   std::vector<std::string>        rigidStructureNames; ///< morea_rigid_structures as resolved
   std::vector<std::string>        structureNames;  ///< indices of base.structures: guidance, then other rigid ones
   MeshModelReport                 report;
@@ -57,7 +57,7 @@ struct MeshModel
 /** The structures the mesh follows: those named by problem_guidance_selection
  *  ("-1": all but "body"). Throws on a name the problem does not have. */
 std::vector<std::string>
-GuidanceStructureNames(const RegistrationProblem & problem, const ::morea::ParameterSet & parameters);
+GuidanceStructureNames(const RegistrationProblem & problem, const morea_core::ParameterSet & parameters);
 
 /** Builds the mesh model of a preprocessed problem (both images on one grid)
  *  from the morea_mesh_* keys, morea_elasticity_factors (used when
@@ -67,23 +67,23 @@ GuidanceStructureNames(const RegistrationProblem & problem, const ::morea::Param
  *  that do not guide contribute contour points to the mesh like guidance
  *  structures) and seed. */
 MeshModel
-BuildMeshModel(const RegistrationProblem & problem, const ::morea::ParameterSet & parameters);
+BuildMeshModel(const RegistrationProblem & problem, const morea_core::ParameterSet & parameters);
 
 /** The next mesh level: `coarse`'s base mesh bisected to `targetPoints`
- *  points where `density` (per coarse tetrahedron, morea::RefinementDensity)
+ *  points where `density` (per coarse tetrahedron, morea_core::RefinementDensity)
  *  is highest, with its topology, parallel structure, elasticity and
  *  rigidity derived afresh from the problem's masks; `refinement` receives
- *  what carries solutions over (morea::CarryOver). */
+ *  what carries solutions over (morea_core::CarryOver). */
 MeshModel
-RefineMeshModel(const MeshModel & coarse, const RegistrationProblem & problem, const ::morea::ParameterSet & parameters,
-                const std::vector<double> & density, std::size_t targetPoints, ::morea::MeshRefinement & refinement);
+RefineMeshModel(const MeshModel & coarse, const RegistrationProblem & problem, const morea_core::ParameterSet & parameters,
+                const std::vector<double> & density, std::size_t targetPoints, morea_core::MeshRefinement & refinement);
 
 /** Writes both meshes of `solution` as .vtu files in physical space with cell
  *  data "elasticity", "rigidity" (the rigidity term's weight, 0 outside
  *  rigid structures) and "signed_volume" and point data "origin" (corner,
  *  face, random, contour, surface, Steiner, refinement, midpoint as 0..7) and "structure". */
 void
-WriteSolutionMeshes(const MeshModel & model, const ::morea::DualMesh & solution, const std::string & movingPath,
+WriteSolutionMeshes(const MeshModel & model, const morea_core::DualMesh & solution, const std::string & movingPath,
                     const std::string & fixedPath);
 } // namespace morea
 } // namespace itk

@@ -13,15 +13,15 @@
 
 #include "itkMeshModel.h"
 #include "itkRegistrationProblem.h"
-#include "morea/EvaluationBackend.h"
-#include "morea/MoRvGomea.h"
-#include "morea/RunFingerprint.h"
+#include "morea_core/EvaluationBackend.h"
+#include "morea_core/MoRvGomea.h"
+#include "morea_core/RunFingerprint.h"
 
 #include <functional>
 #include <string>
 #include <vector>
 
-namespace morea
+namespace morea_core
 {
 class ParameterSet;
 }
@@ -41,35 +41,35 @@ struct MeshRegistrationOptions
   std::size_t threads{ 0 }; ///< CPU backend threads (CUDA: host threads packing batches); 0: all
   /** Which evaluation backend: the CPU, CUDA (texture or exact
    *  interpolation), or auto: the texture path when a device is usable. */
-  ::morea::BackendChoice backend{ ::morea::BackendChoice::Auto };
+  morea_core::BackendChoice backend{ morea_core::BackendChoice::Auto };
   int                    device{ 0 };              ///< CUDA device ordinal
   int                    minimumComputeLevel{ 0 }; ///< a device below this compute capability (x10) is not used
   /** Whether candidates that a bound shows refused go unsampled
    *  (morea/RefusalBound.h); the result is the same either way. */
-  ::morea::RefusalBoundChoice refusalBounds{ ::morea::RefusalBoundChoice::Auto };
+  morea_core::RefusalBoundChoice refusalBounds{ morea_core::RefusalBoundChoice::Auto };
   /** Entries the caller adds to the run's fingerprint (what the checkpoint
    *  belongs to), before those RegisterMeshes adds itself: the parameters,
    *  the preprocessed images, body masks and structures (RunFingerprintOf),
    *  and the mesh. A resume whose fingerprint differs is refused, naming the
    *  first key that differs. */
-  ::morea::RunFingerprint fingerprint;
+  morea_core::RunFingerprint fingerprint;
   /** After each generation (also the resumed ones' replay is not called). May throw to abort. */
-  std::function<void(const ::morea::GenerationRecord &, std::size_t generations)> onGeneration;
+  std::function<void(const morea_core::GenerationRecord &, std::size_t generations)> onGeneration;
 };
 
 /** One solution of the approximation set. */
 struct FrontSolution
 {
   std::uint64_t       id{ 0 };
-  ::morea::Fitness    fitness;
-  ::morea::DualMesh   mesh;
+  morea_core::Fitness    fitness;
+  morea_core::DualMesh   mesh;
 };
 
 struct MeshRegistrationResult
 {
   MeshModel                              model;
   std::vector<FrontSolution>             front; ///< the elitist archive, by ascending guidance
-  std::vector<::morea::GenerationRecord> history;
+  std::vector<morea_core::GenerationRecord> history;
   std::string                            backend;     ///< the backend's name: cpu, cuda-texture, cuda-exact
   std::string                            backendNote; ///< why it runs there ("" when asked for by name and used)
   std::string                            pathNote;    ///< a faster path the backend could not take, and why; "" when none
@@ -88,12 +88,12 @@ struct MeshRegistrationResult
  *  the images' grids and a hash of their voxels, the body masks, and each
  *  structure's masks and points, in order. RegisterMeshes stores it in checkpoints; `morea benchmark
  *  --from-checkpoint` gives the same. */
-::morea::RunFingerprint
-RunFingerprintOf(const RegistrationProblem & problem, const ::morea::ParameterSet & parameters);
+morea_core::RunFingerprint
+RunFingerprintOf(const RegistrationProblem & problem, const morea_core::ParameterSet & parameters);
 
 /** Registers a preprocessed problem (both images on one grid). */
 MeshRegistrationResult
-RegisterMeshes(const RegistrationProblem & problem, const ::morea::ParameterSet & parameters,
+RegisterMeshes(const RegistrationProblem & problem, const morea_core::ParameterSet & parameters,
                const MeshRegistrationOptions & options = {});
 } // namespace morea
 } // namespace itk

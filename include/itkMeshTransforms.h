@@ -17,10 +17,10 @@
 #include "itkDisplacementFieldTransform.h"
 #include "itkMOREATypes.h"
 #include "itkRigidPreAlignment.h"
-#include "morea/FieldFoldRepair.h"
-#include "morea/MeshRasterizer.h"
-#include "morea/TetrahedralMesh.h"
-#include "morea/VtuWriter.h"
+#include "morea_core/FieldFoldRepair.h"
+#include "morea_core/MeshRasterizer.h"
+#include "morea_core/TetrahedralMesh.h"
+#include "morea_core/VtuWriter.h"
 
 #include <array>
 #include <cstdint>
@@ -56,15 +56,15 @@ public:
   bool
   IsAlignedWith(const ImageBase<Dimension> * grid, double tolerance = 1e-6) const;
 
-  ::morea::Vec3
+  morea_core::Vec3
   ToFrame(const PointType & physical) const;
   PointType
-  ToPhysical(const ::morea::Vec3 & frame) const;
+  ToPhysical(const morea_core::Vec3 & frame) const;
   /** Displacements: the same rotation (the frame shares physical space's origin). */
-  ::morea::Vec3
+  morea_core::Vec3
   VectorToFrame(const DisplacementVectorType & physical) const;
   DisplacementVectorType
-  VectorToPhysical(const ::morea::Vec3 & frame) const;
+  VectorToPhysical(const morea_core::Vec3 & frame) const;
 
   /** The grid of `grid` (its largest possible region) in this frame: voxels
    *  per axis, spacing, and the first voxel's centre. Throws unless the grid
@@ -72,15 +72,15 @@ public:
   struct GridGeometry
   {
     std::array<std::size_t, 3> size{ { 0, 0, 0 } };
-    ::morea::Vec3              spacing{ { 1.0, 1.0, 1.0 } };
-    ::morea::Vec3              origin{ { 0.0, 0.0, 0.0 } };
+    morea_core::Vec3              spacing{ { 1.0, 1.0, 1.0 } };
+    morea_core::Vec3              origin{ { 0.0, 0.0, 0.0 } };
   };
   GridGeometry
   GeometryOf(const ImageBase<Dimension> * grid) const;
 
   /** The same grid as an axis-aligned core displacement volume, filled with
    *  zeros. */
-  ::morea::Volume<::morea::Vec3>
+  morea_core::Volume<morea_core::Vec3>
   FieldGridOf(const ImageBase<Dimension> * grid) const;
 
 private:
@@ -91,12 +91,12 @@ private:
  *  direction), and back. The ITK images must be fully buffered and aligned with
  *  the frame. */
 ImageType::Pointer
-ToImage(const ::morea::Volume<float> & volume, const DomainFrame & frame);
+ToImage(const morea_core::Volume<float> & volume, const DomainFrame & frame);
 MaskType::Pointer
-ToMask(const ::morea::Volume<std::uint8_t> & volume, const DomainFrame & frame);
-::morea::Volume<float>
+ToMask(const morea_core::Volume<std::uint8_t> & volume, const DomainFrame & frame);
+morea_core::Volume<float>
 ToVolume(const ImageType * image, const DomainFrame & frame);
-::morea::Volume<std::uint8_t>
+morea_core::Volume<std::uint8_t>
 ToVolume(const MaskType * mask, const DomainFrame & frame);
 
 /** A solution's registration as ITK fields and transforms (physical space). */
@@ -113,12 +113,12 @@ struct MeshFields
   /** Maps moving points to fixed points (fields on the moving grid). */
   DisplacementFieldTransformType::Pointer movingToFixedTransform;
   /** Rasterisation of fixedToMoving and movingToFixed (voxels outside the mesh). */
-  ::morea::RasterizationReport fixedReport;
-  ::morea::RasterizationReport movingReport;
+  morea_core::RasterizationReport fixedReport;
+  morea_core::RasterizationReport movingReport;
   /** Voxel-level fold repair of fixedToMoving and movingToFixed (see
    *  morea/FieldFoldRepair.h): how many voxels were folded and smoothed. */
-  ::morea::FieldFoldRepairReport fixedFoldRepair;
-  ::morea::FieldFoldRepairReport movingFoldRepair;
+  morea_core::FieldFoldRepairReport fixedFoldRepair;
+  morea_core::FieldFoldRepairReport movingFoldRepair;
 };
 
 /** Rasterises a solution: `solution.target` is the mesh on the fixed image and
@@ -126,11 +126,11 @@ struct MeshFields
  *  the grids, which must share their direction. When the grids differ, each
  *  transform's inverse field is rasterised once more on its forward field's
  *  grid (the piecewise-affine map is extrapolated outside the mesh). Every
- *  field is then made fold-free at voxel level (::morea::RemoveVoxelFolds):
+ *  field is then made fold-free at voxel level (morea_core::RemoveVoxelFolds):
  *  the exact map is kept except around voxels whose finite-difference
  *  Jacobian determinant is <= 0. */
 MeshFields
-RasterizeSolution(const ::morea::MeshTopology & topology, const ::morea::DualMesh & solution,
+RasterizeSolution(const morea_core::MeshTopology & topology, const morea_core::DualMesh & solution,
                   const ImageBase<Dimension> * fixedGrid, const ImageBase<Dimension> * movingGrid);
 
 /** The transforms of a chosen solution between the original images: the
@@ -162,9 +162,9 @@ WriteSolutionTransforms(const OriginalFrameTransforms & transforms, const std::s
  *  (ParaView, 3D Slicer); atomic. Tetrahedra are reordered to stay positively
  *  oriented when the direction is a reflection. */
 void
-WriteMeshVtu(const std::string & path, const ::morea::MeshTopology & topology,
-             const std::vector<::morea::Vec3> & framePoints, const DomainFrame & frame,
-             const std::vector<::morea::VtuArray> & cellData, const std::vector<::morea::VtuArray> & pointData = {});
+WriteMeshVtu(const std::string & path, const morea_core::MeshTopology & topology,
+             const std::vector<morea_core::Vec3> & framePoints, const DomainFrame & frame,
+             const std::vector<morea_core::VtuArray> & cellData, const std::vector<morea_core::VtuArray> & pointData = {});
 
 } // namespace morea
 } // namespace itk

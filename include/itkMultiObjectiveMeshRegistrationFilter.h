@@ -11,7 +11,7 @@
 #include "itkPointSet.h"
 #include "itkProcessObject.h"
 #include "itkSimpleDataObjectDecorator.h"
-#include "morea/ParameterSet.h"
+#include "morea_core/ParameterSet.h"
 
 #include <string>
 #include <vector>
@@ -36,7 +36,7 @@ namespace itk
  * in 3D Slicer); optional body masks restrict the foreground; optional
  * landmark point sets (SetFixedLandmarks, SetMovingLandmarks) are carried
  * into the preprocessed frame for evaluation. Parameters are a
- * ::morea::ParameterSet (the MOREA parameter-file keys), set whole, from a
+ * morea_core::ParameterSet (the MOREA parameter-file keys), set whole, from a
  * TOML file, key by key or through the convenience setters.
  *
  * The run: the problem is validated and preprocessed (isotropic resampling,
@@ -98,8 +98,8 @@ public:
   using InitialTransformType = TransformBaseTemplate<double>;
   using DecoratedInitialTransformType = DataObjectDecorator<InitialTransformType>;
   using DisplacementFieldTransformType = morea::DisplacementFieldTransformType;
-  using ParameterSetType = ::morea::ParameterSet;
-  using GenerationRecordType = ::morea::GenerationRecord;
+  using ParameterSetType = morea_core::ParameterSet;
+  using GenerationRecordType = morea_core::GenerationRecord;
   using PreprocessReportType = morea::PreprocessReport;
 
   using ApproximationSolutionType = morea::ApproximationSolution;

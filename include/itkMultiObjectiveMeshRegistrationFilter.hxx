@@ -215,7 +215,7 @@ MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::SetBackend(cons
 {
   try
   {
-    ::morea::ParseBackendChoice(backend);
+    morea_core::ParseBackendChoice(backend);
   }
   catch (const std::exception & e)
   {
@@ -261,7 +261,7 @@ MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::SetRefusalBound
 {
   try
   {
-    ::morea::ParseRefusalBoundChoice(choice);
+    morea_core::ParseRefusalBoundChoice(choice);
   }
   catch (const std::exception & e)
   {
@@ -528,8 +528,8 @@ MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GenerateData()
     // one thread per core).
     options.threads = std::max<SizeValueType>(
       1, std::min<SizeValueType>(this->GetNumberOfWorkUnits(), this->GetMultiThreader()->GetMaximumNumberOfThreads()));
-    options.backend = ::morea::ParseBackendChoice(m_Backend);
-    options.refusalBounds = ::morea::ParseRefusalBoundChoice(m_RefusalBounds);
+    options.backend = morea_core::ParseBackendChoice(m_Backend);
+    options.refusalBounds = morea_core::ParseRefusalBoundChoice(m_RefusalBounds);
     // Between generations is the only point the run can stop at cleanly; both
     // callbacks check, so that an observer of either event stops it at once.
     const auto stopIfAborted = [this]() {
@@ -595,7 +595,7 @@ MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GenerateData()
   }
   catch (const std::exception & e)
   {
-    // Core errors (::morea::Error) carry a message meant for the user.
+    // Core errors (morea_core::Error) carry a message meant for the user.
     itkExceptionMacro(<< e.what());
   }
 

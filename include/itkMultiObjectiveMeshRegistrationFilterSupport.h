@@ -23,7 +23,7 @@
 #include <string>
 #include <vector>
 
-namespace morea
+namespace morea_core
 {
 class ParameterSet;
 }
@@ -60,13 +60,13 @@ struct SolutionChoice
   std::size_t index{ 0 };
 };
 
-/** Throws ::morea::Error unless `selection` is a comma-separated list of
+/** Throws morea_core::Error unless `selection` is a comma-separated list of
  *  best-guidance, knee, weighted:a:b:c, nearest:m:i:g and all, with at least one item. */
 void
 CheckSolutionSelection(const std::string & selection);
 
 /** The solutions `selection` names, in its order; a label chosen twice counts
- *  once. Throws ::morea::Error on an empty set or a bad selection. */
+ *  once. Throws morea_core::Error on an empty set or a bad selection. */
 std::vector<SolutionChoice>
 SelectSolutions(const ApproximationSet & set, const std::string & selection);
 
@@ -100,9 +100,9 @@ constexpr double OptimisationProgressEnd = 0.95;
 
 /** Refuses, with a message naming the key, parameter values one
  *  registration cannot honour: num_runs > 1 (the command line runs several)
- *  and zip = true (the filter writes no folder). Throws ::morea::Error. */
+ *  and zip = true (the filter writes no folder). Throws morea_core::Error. */
 void
-CheckSingleRunParameters(const ::morea::ParameterSet & parameters);
+CheckSingleRunParameters(const morea_core::ParameterSet & parameters);
 
 /** Validates `problem`, preprocesses it (pre-aligned by `initialTransform`
  *  when given, else as the parameters say), runs MOREA and rasterises the
@@ -110,9 +110,9 @@ CheckSingleRunParameters(const ::morea::ParameterSet & parameters);
  *  its lowest compute level come from the parameters (cuda_gpu_id,
  *  cuda_compute_level). `progress` (may be empty) gets the cumulative
  *  fraction done; it and `options.onGeneration` may throw to abort. Throws
- *  ::morea::Error (or what the callbacks throw). */
+ *  morea_core::Error (or what the callbacks throw). */
 MultiObjectiveRegistrationRun
-RunMultiObjectiveRegistration(const RegistrationProblem & problem, const ::morea::ParameterSet & parameters,
+RunMultiObjectiveRegistration(const RegistrationProblem & problem, const morea_core::ParameterSet & parameters,
                               const MeshRegistrationOptions & options, const std::string & selection,
                               const std::function<void(double)> & progress,
                               const PreAlignmentTransformType * initialTransform = nullptr);
@@ -124,7 +124,7 @@ UserMessage(const std::string & description);
 
 /** Prints the explicitly set parameters and the main run keys, one per line. */
 void
-PrintParameters(std::ostream & os, const ::morea::ParameterSet & parameters, Indent indent);
+PrintParameters(std::ostream & os, const morea_core::ParameterSet & parameters, Indent indent);
 } // namespace morea
 } // namespace itk
 

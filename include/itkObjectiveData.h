@@ -14,9 +14,9 @@
 #include "itkMOREATypes.h"
 #include "itkMeshModel.h"
 #include "itkRegistrationProblem.h"
-#include "morea/ObjectiveData.h"
+#include "morea_core/ObjectiveData.h"
 
-namespace morea
+namespace morea_core
 {
 class ParameterSet;
 }
@@ -34,15 +34,15 @@ namespace morea
  *  DefaultGuidanceRadius(domain extent), morea_sampling_rate, voxel volume.
  *  Throws when the images are not on one grid aligned with the model's frame, or
  *  a guidance structure has neither a non-empty mask nor points on a side. */
-::morea::ObjectiveData
+morea_core::ObjectiveData
 BuildObjectiveData(const RegistrationProblem & problem, const MeshModel & model,
-                   const ::morea::ParameterSet & parameters);
+                   const morea_core::ParameterSet & parameters);
 
 /** The same in the frame `frame` (a model's frame is DomainFrame::Of(its moving
  *  image)), without a model: RegisterMeshes makes it while the mesh is built. */
-::morea::ObjectiveData
+morea_core::ObjectiveData
 BuildObjectiveData(const RegistrationProblem & problem, const DomainFrame & frame,
-                   const ::morea::ParameterSet & parameters);
+                   const morea_core::ParameterSet & parameters);
 
 /** Unsigned distance in mm from every voxel centre of `grid` to the structure's surface:
  *  from the mask when present and non-empty (signed Maurer distances with image spacing,

@@ -9,7 +9,7 @@
 
 #include "itkMOREATypes.h"
 #include "itkRegistrationProblem.h"
-#include "morea/Phantom.h"
+#include "morea_core/Phantom.h"
 
 #include <map>
 #include <string>
@@ -19,15 +19,15 @@ namespace itk
 namespace morea
 {
 ImageType::Pointer
-ToImage(const ::morea::Volume<float> & volume);
+ToImage(const morea_core::Volume<float> & volume);
 MaskType::Pointer
-ToMask(const ::morea::Volume<std::uint8_t> & volume);
+ToMask(const morea_core::Volume<std::uint8_t> & volume);
 DisplacementFieldType::Pointer
-ToDisplacementField(const ::morea::Volume<::morea::Vec3> & volume);
+ToDisplacementField(const morea_core::Volume<morea_core::Vec3> & volume);
 
 /** The phantom case as a registration problem (images in HU, masks, landmarks). */
 RegistrationProblem
-MakePhantomProblem(const ::morea::PelvisPhantom::Case & phantomCase);
+MakePhantomProblem(const morea_core::PelvisPhantom::Case & phantomCase);
 
 /** Paths of a phantom written to a folder. */
 struct PhantomFiles
@@ -47,7 +47,7 @@ struct PhantomFiles
  *  point files) and the true displacement fields (NIfTI vector images) into
  *  `folder`; every file is written atomically. */
 PhantomFiles
-WritePhantomCase(const ::morea::PelvisPhantom::Case & phantomCase, const std::string & folder);
+WritePhantomCase(const morea_core::PelvisPhantom::Case & phantomCase, const std::string & folder);
 
 } // namespace morea
 } // namespace itk

@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-namespace morea
+namespace morea_core
 {
 class ParameterSet;
 }
@@ -41,7 +41,7 @@ struct PreprocessOptions
   PreAlignmentTransformType::ConstPointer initialTransform;
 
   static PreprocessOptions
-  FromParameters(const ::morea::ParameterSet & parameters);
+  FromParameters(const morea_core::ParameterSet & parameters);
 };
 
 /** Foreground voxels are mapped into [ForegroundFloor, 1] so that only
@@ -82,7 +82,7 @@ Preprocess(const RegistrationProblem & input, const PreprocessOptions & options)
  *  in problem_guidance_selection) was dropped by preprocessing, with the
  *  reason and the fix: a registration would otherwise run without it. */
 void
-CheckGuidanceStructuresKept(const PreprocessReport & report, const ::morea::ParameterSet & parameters);
+CheckGuidanceStructuresKept(const PreprocessReport & report, const morea_core::ParameterSet & parameters);
 
 // The steps, usable alone.
 

@@ -10,7 +10,7 @@
 
 #include "itkMultiObjectiveMeshRegistrationFilterSupport.h"
 #include "itkRegistrationEvaluation.h"
-#include "morea/ParameterSet.h"
+#include "morea_core/ParameterSet.h"
 
 #include <nlohmann/json.hpp>
 
@@ -43,11 +43,11 @@ constexpr const char * RegistrationSummaryFileName = "summary.json";
  *  removed; summary.json (the scores, the rigid baseline, the backend and
  *  why, the labels and, where `times` is given, each stage's seconds) is
  *  written last and returned. A failure leaves no new file but the folder's
- *  earlier checkpoint. The caller owns the folder (::morea::OutputFolderLock).
+ *  earlier checkpoint. The caller owns the folder (morea_core::OutputFolderLock).
  *  `trueFixedToMoving`, when known (phantoms), adds the mean displacement
- *  error in the body. Throws ::morea::Error or itk::ExceptionObject. */
+ *  error in the body. Throws morea_core::Error or itk::ExceptionObject. */
 nlohmann::json
-WriteRegistrationOutputs(const MultiObjectiveRegistrationRun & run, const ::morea::ParameterSet & parameters,
+WriteRegistrationOutputs(const MultiObjectiveRegistrationRun & run, const morea_core::ParameterSet & parameters,
                          const std::string & folder, const DisplacementFieldType * trueFixedToMoving = nullptr,
                          const RegistrationOutputTimes * times = nullptr);
 

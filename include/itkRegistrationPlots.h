@@ -46,10 +46,10 @@ enum class SliceView
 };
 
 /** SliceView by name: overlay, checkerboard-before, checkerboard, difference-before,
- *  difference, jacobian, grid. Throws ::morea::Error on another name. */
+ *  difference, jacobian, grid. Throws morea_core::Error on another name. */
 SliceView
 SliceViewFromName(const std::string & name);
-/** "axial", "coronal", "sagittal". Throws ::morea::Error on another name. */
+/** "axial", "coronal", "sagittal". Throws morea_core::Error on another name. */
 SliceAxis
 SliceAxisFromName(const std::string & name);
 const char *
@@ -86,7 +86,7 @@ public:
 
   /** The slice as a picture, `pixelsPerMm` output pixels per millimetre
    *  (square pixels); with `contours` each structure's fixed contour (solid)
-   *  and warped moving contour (dashed) on top. Throws ::morea::Error for a
+   *  and warped moving contour (dashed) on top. Throws morea_core::Error for a
    *  slice outside the image. */
   PlotCanvas
   Render(SliceAxis axis, long slice, SliceView view, bool contours, double pixelsPerMm) const;

@@ -18,7 +18,7 @@
 #include "itkMeshTransforms.h"
 #include "itkRegistrationProblem.h"
 #include "itkRigidPreAlignment.h"
-#include "morea/ParameterSet.h"
+#include "morea_core/ParameterSet.h"
 
 #include <nlohmann/json.hpp>
 
@@ -36,7 +36,7 @@ constexpr const char * PreprocessedFolderName = "preprocessed";
 /** Writes FOLDER/front_meshes.bin: `topology`'s tetrahedra and, per front
  *  solution, its id, objectives, constraint and both meshes (atomically). */
 void
-WriteFrontMeshes(const ::morea::MeshTopology & topology, const std::vector<FrontSolution> & front,
+WriteFrontMeshes(const morea_core::MeshTopology & topology, const std::vector<FrontSolution> & front,
                  const std::string & path);
 
 /** Writes a preprocessed problem as a problem folder (WriteProblemFolder
@@ -46,7 +46,7 @@ WriteFrontMeshes(const ::morea::MeshTopology & topology, const std::vector<Front
 void
 WritePreprocessedProblem(const RegistrationProblem & problem, const std::string & folder);
 
-/** Throws ::morea::Error, saying what is wrong, unless `folder` holds a
+/** Throws morea_core::Error, saying what is wrong, unless `folder` holds a
  *  complete run that can be looked at: it exists, is a run's folder
  *  (front.json), no run is writing it now (.morea.lock), its outputs are
  *  whole (summary.json, no staging folder left) and it keeps the saved front
@@ -60,14 +60,14 @@ struct SavedRegistrationRun
   std::string                           folder;
   RegistrationProblem                   problem; ///< preprocessed
   PreAlignmentTransformType::Pointer    rigid;   ///< original fixed -> original moving before the field
-  ::morea::ParameterSet                 parameters;
-  ::morea::MeshTopology                 topology;
+  morea_core::ParameterSet                 parameters;
+  morea_core::MeshTopology                 topology;
   std::vector<FrontSolution>            front;   ///< by ascending guidance, as front.json
   std::vector<std::string>              chosen;  ///< per front solution: its labels in the run ("" none)
   nlohmann::json                        summary;
 };
 
-/** Reads a run's folder (CheckRunFolder first). Throws ::morea::Error. */
+/** Reads a run's folder (CheckRunFolder first). Throws morea_core::Error. */
 SavedRegistrationRun
 ReadRunFolder(const std::string & folder);
 

@@ -6,7 +6,7 @@
 #ifndef morea_test_BoxMesh_h
 #define morea_test_BoxMesh_h
 
-#include "morea/TetrahedralMesh.h"
+#include "morea_core/TetrahedralMesh.h"
 
 #include <algorithm>
 #include <array>
@@ -19,14 +19,14 @@ namespace morea_test
 {
 struct BoxMesh
 {
-  morea::MeshDomain               domain;
-  std::vector<morea::Vec3>        points;
-  std::vector<morea::Tetrahedron> tetrahedra;
+  morea_core::MeshDomain               domain;
+  std::vector<morea_core::Vec3>        points;
+  std::vector<morea_core::Tetrahedron> tetrahedra;
   std::array<std::size_t, 3>      cells{};
 };
 
 inline BoxMesh
-MakeBoxMesh(const morea::MeshDomain & domain, std::array<std::size_t, 3> cells)
+MakeBoxMesh(const morea_core::MeshDomain & domain, std::array<std::size_t, 3> cells)
 {
   BoxMesh mesh;
   mesh.domain = domain;
@@ -41,7 +41,7 @@ MakeBoxMesh(const morea::MeshDomain & domain, std::array<std::size_t, 3> cells)
       for (std::size_t i = 0; i <= cells[0]; ++i)
       {
         const std::array<std::size_t, 3> index{ { i, j, k } };
-        morea::Vec3                      p;
+        morea_core::Vec3                      p;
         for (int a = 0; a < 3; ++a)
         {
           // The last layer is exactly on the upper face (no round-off).
@@ -61,14 +61,14 @@ MakeBoxMesh(const morea::MeshDomain & domain, std::array<std::size_t, 3> cells)
         for (const auto & order : permutations)
         {
           std::array<std::size_t, 3> c{ { i, j, k } };
-          morea::Tetrahedron         t;
+          morea_core::Tetrahedron         t;
           t[0] = id(c[0], c[1], c[2]);
           for (int step = 0; step < 3; ++step)
           {
             ++c[order[step]];
             t[step + 1] = id(c[0], c[1], c[2]);
           }
-          if (morea::SignedVolume(t, mesh.points) < 0.0)
+          if (morea_core::SignedVolume(t, mesh.points) < 0.0)
             std::swap(t[2], t[3]);
           mesh.tetrahedra.push_back(t);
         }
@@ -77,12 +77,12 @@ MakeBoxMesh(const morea::MeshDomain & domain, std::array<std::size_t, 3> cells)
 
 /** Moves points by up to `fraction` of the cell size per axis, keeping points
  *  on the box boundary on their faces (so the perturbed mesh covers the box). */
-inline std::vector<morea::Vec3>
+inline std::vector<morea_core::Vec3>
 Perturb(const BoxMesh & mesh, double fraction, unsigned seed)
 {
   std::mt19937                           random(seed);
   std::uniform_real_distribution<double> offset(-fraction, fraction);
-  std::vector<morea::Vec3>               moved = mesh.points;
+  std::vector<morea_core::Vec3>               moved = mesh.points;
   for (auto & p : moved)
   {
     for (int a = 0; a < 3; ++a)
@@ -97,11 +97,11 @@ Perturb(const BoxMesh & mesh, double fraction, unsigned seed)
 }
 
 inline double
-MinimumSignedVolume(const std::vector<morea::Tetrahedron> & tetrahedra, const std::vector<morea::Vec3> & points)
+MinimumSignedVolume(const std::vector<morea_core::Tetrahedron> & tetrahedra, const std::vector<morea_core::Vec3> & points)
 {
   double smallest = 1e300;
   for (const auto & t : tetrahedra)
-    smallest = std::min(smallest, morea::SignedVolume(t, points));
+    smallest = std::min(smallest, morea_core::SignedVolume(t, points));
   return smallest;
 }
 } // namespace morea_test

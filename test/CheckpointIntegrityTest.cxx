@@ -8,8 +8,8 @@
 // would leave them, to reach the range checks behind the checksum.
 #include "OptimiserTestProblem.h"
 
-#include "morea/Error.h"
-#include "morea/Hash.h"
+#include "morea_core/Error.h"
+#include "morea_core/Hash.h"
 
 #include <gtest/gtest.h>
 
@@ -19,7 +19,7 @@
 #include <random>
 #include <sstream>
 
-using namespace morea;
+using namespace morea_core;
 using morea_test::OptimiserTestProblem;
 
 namespace

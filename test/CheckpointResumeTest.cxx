@@ -6,9 +6,9 @@
 #include "itkMeshRegistration.h"
 #include "itkPhantomImages.h"
 #include "itkPreprocessing.h"
-#include "morea/Error.h"
-#include "morea/FoldConstraint.h"
-#include "morea/ParameterSet.h"
+#include "morea_core/Error.h"
+#include "morea_core/FoldConstraint.h"
+#include "morea_core/ParameterSet.h"
 
 #include <gtest/gtest.h>
 
@@ -21,17 +21,17 @@ using namespace itk::morea;
 struct SmallRun
 {
   RegistrationProblem   problem;
-  ::morea::ParameterSet parameters;
+  morea_core::ParameterSet parameters;
   std::string           checkpoint;
 
   SmallRun()
   {
-    ::morea::PhantomOptions phantom;
+    morea_core::PhantomOptions phantom;
     phantom.spacing = 4.0;
     PreprocessOptions pre;
     pre.isotropicSpacing = 4.0;
     pre.rigidStructure = "none";
-    problem = Preprocess(MakePhantomProblem(::morea::PelvisPhantom(phantom).Generate()), pre).problem;
+    problem = Preprocess(MakePhantomProblem(morea_core::PelvisPhantom(phantom).Generate()), pre).problem;
     for (const auto & [key, value] : std::vector<std::pair<std::string, std::string>>{
            { "ea_population_size", "8" },
            { "ea_num_clusters", "2" },
@@ -52,19 +52,19 @@ struct SmallRun
   }
 
   MeshRegistrationResult
-  Run(const ::morea::ParameterSet & p, const RegistrationProblem & on) const
+  Run(const morea_core::ParameterSet & p, const RegistrationProblem & on) const
   {
     MeshRegistrationOptions options;
     options.checkpointPath = checkpoint;
     options.checkpointInterval = 1;
     options.resume = true;
-    options.backend = ::morea::BackendChoice::Cpu;
+    options.backend = morea_core::BackendChoice::Cpu;
     options.threads = 2;
     return RegisterMeshes(on, p, options);
   }
   /** The message of the resume's refusal; "" when it resumed. */
   std::string
-  Refusal(const ::morea::ParameterSet & p, const RegistrationProblem & on) const
+  Refusal(const morea_core::ParameterSet & p, const RegistrationProblem & on) const
   {
     try
     {
@@ -85,13 +85,13 @@ TEST(CheckpointResume, OtherParametersOrImagesAreRefusedNamingTheKey)
   ASSERT_TRUE(std::filesystem::exists(run.checkpoint));
   const std::string prefix = "checkpoint " + run.checkpoint + ": it was written by a run with other inputs or parameters (";
 
-  ::morea::ParameterSet rate = run.parameters;
+  morea_core::ParameterSet rate = run.parameters;
   rate.SetFromString("morea_sampling_rate", "0.5");
   EXPECT_EQ(run.Refusal(rate, run.problem),
             prefix + "morea_sampling_rate: 0.3 in the checkpoint, 0.5 in this run); resume with those it was written "
                      "with, or start afresh");
 
-  ::morea::ParameterSet factors = run.parameters;
+  morea_core::ParameterSet factors = run.parameters;
   factors.SetFromString("morea_elasticity_factors", "bones=10, bladder=2");
   EXPECT_EQ(run.Refusal(factors, run.problem),
             prefix + "morea_elasticity_factors: \"bones=10, bladder=0.5\" in the checkpoint, \"bones=10, bladder=2\" "
@@ -110,13 +110,13 @@ TEST(CheckpointResume, OtherParametersOrImagesAreRefusedNamingTheKey)
   EXPECT_EQ(image.rfind(prefix + "moving image voxels: xxh64:", 0), 0u) << image;
 
   // A run that ends before the checkpoint's generation.
-  ::morea::ParameterSet shorter = run.parameters;
+  morea_core::ParameterSet shorter = run.parameters;
   shorter.SetFromString("ea_num_generations", "1");
   EXPECT_EQ(run.Refusal(shorter, run.problem),
             "checkpoint " + run.checkpoint + ": it holds generation 2, beyond this run's 1 (ea_num_generations)");
 
   // The same, for longer: resumes.
-  ::morea::ParameterSet longer = run.parameters;
+  morea_core::ParameterSet longer = run.parameters;
   longer.SetFromString("ea_num_generations", "3");
   const auto resumed = run.Run(longer, run.problem);
   EXPECT_EQ(resumed.resumedAtGeneration, 2u);
@@ -126,22 +126,22 @@ TEST(CheckpointResume, OtherParametersOrImagesAreRefusedNamingTheKey)
 TEST(CheckpointResume, MultiLevelRunsRefineCarryOverAndResumeAcrossLevels)
 {
   SmallRun              run;
-  ::morea::ParameterSet p = run.parameters;
+  morea_core::ParameterSet p = run.parameters;
   p.SetFromString("ea_num_generations", "4");
   p.SetFromString("morea_max_num_mesh_levels", "2");
   p.SetFromString("morea_num_generations_per_level", "2");
   p.SetFromString("morea_mesh_refinement_factor", "2");
   MeshRegistrationOptions plain;
-  plain.backend = ::morea::BackendChoice::Cpu;
+  plain.backend = morea_core::BackendChoice::Cpu;
   plain.threads = 2;
   const MeshRegistrationResult whole = RegisterMeshes(run.problem, p, plain);
   const auto &                 mesh = whole.model.base;
-  const auto midpoints = std::count(mesh.origins.begin(), mesh.origins.end(), ::morea::PointOrigin::Midpoint);
+  const auto midpoints = std::count(mesh.origins.begin(), mesh.origins.end(), morea_core::PointOrigin::Midpoint);
   EXPECT_EQ(2 * (mesh.NumberOfPoints() - static_cast<std::size_t>(midpoints)), mesh.NumberOfPoints());
   ASSERT_EQ(whole.history.size(), 5u); // generations 0 to 4, once each
   for (std::size_t g = 0; g < whole.history.size(); ++g)
     EXPECT_EQ(whole.history[g].generation, g);
-  const ::morea::FoldConstraint constraint(whole.model.topology, mesh.points);
+  const morea_core::FoldConstraint constraint(whole.model.topology, mesh.points);
   ASSERT_FALSE(whole.front.empty());
   for (const auto & s : whole.front)
   {
@@ -155,7 +155,7 @@ TEST(CheckpointResume, MultiLevelRunsRefineCarryOverAndResumeAcrossLevels)
   options.checkpointPath = run.checkpoint;
   options.checkpointInterval = 1;
   options.resume = true;
-  options.onGeneration = [](const ::morea::GenerationRecord & record, std::size_t total) {
+  options.onGeneration = [](const morea_core::GenerationRecord & record, std::size_t total) {
     EXPECT_EQ(total, 4u);
     if (record.generation == 3)
       throw std::runtime_error("stopped");

@@ -1,9 +1,9 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
 // Tests of checkpoint files written behind the optimiser.
-#include "morea/CheckpointWriter.h"
+#include "morea_core/CheckpointWriter.h"
 
-#include "morea/Error.h"
+#include "morea_core/Error.h"
 
 #include <gtest/gtest.h>
 
@@ -13,7 +13,7 @@
 
 namespace
 {
-using namespace morea;
+using namespace morea_core;
 
 std::string
 ReadAll(const std::filesystem::path & path)

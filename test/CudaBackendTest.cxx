@@ -7,9 +7,9 @@
 // themselves when no CUDA device is present; the selection tests run anywhere.
 #include "OptimiserTestProblem.h"
 
-#include "morea/ComputeDevices.h"
-#include "morea/Error.h"
-#include "morea/Random.h"
+#include "morea_core/ComputeDevices.h"
+#include "morea_core/Error.h"
+#include "morea_core/Random.h"
 
 #include <gtest/gtest.h>
 
@@ -22,7 +22,7 @@
 #include <string>
 #include <vector>
 
-using namespace morea;
+using namespace morea_core;
 using morea_test::OptimiserTestProblem;
 
 namespace

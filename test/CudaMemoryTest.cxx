@@ -2,13 +2,13 @@
 // SPDX-License-Identifier: Apache-2.0
 // The CUDA backend and the device's memory: its estimate grows with the
 // population, a batch larger than the device is reported as out of GPU memory
-// (morea::OutOfDeviceMemory, which RegisterMeshes completes with the run's
+// (morea_core::OutOfDeviceMemory, which RegisterMeshes completes with the run's
 // figures), and the backend goes on afterwards. Skips without a device.
 #include "OptimiserTestProblem.h"
 
-#include "morea/ComputeDevices.h"
-#include "morea/Error.h"
-#include "morea/MemoryEstimate.h"
+#include "morea_core/ComputeDevices.h"
+#include "morea_core/Error.h"
+#include "morea_core/MemoryEstimate.h"
 
 #include <gtest/gtest.h>
 
@@ -17,7 +17,7 @@
 
 namespace
 {
-using namespace morea;
+using namespace morea_core;
 using morea_test::OptimiserTestProblem;
 
 TEST(CudaMemory, EstimateNamesTheDeviceAndGrowsWithThePopulation)

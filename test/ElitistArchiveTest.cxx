@@ -1,11 +1,11 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-// Tests of morea::ElitistArchive: non-domination, the capacity kept by
+// Tests of morea_core::ElitistArchive: non-domination, the capacity kept by
 // discretising objective space, checkpoint restore and the stored payload.
 // Core tests: no ITK.
-#include "morea/ElitistArchive.h"
-#include "morea/Error.h"
-#include "morea/Random.h"
+#include "morea_core/ElitistArchive.h"
+#include "morea_core/Error.h"
+#include "morea_core/Random.h"
 
 #include <gtest/gtest.h>
 
@@ -17,9 +17,9 @@
 
 namespace
 {
-using morea::ElitistArchive;
-using morea::Fitness;
-using morea::ObjectiveVector;
+using morea_core::ElitistArchive;
+using morea_core::Fitness;
+using morea_core::ObjectiveVector;
 
 Fitness
 Feasible(double a, double b, double c)
@@ -28,11 +28,11 @@ Feasible(double a, double b, double c)
 }
 
 /** A payload that tells which solution it belongs to. */
-morea::DualMesh
+morea_core::DualMesh
 PayloadOf(std::uint64_t id)
 {
   const double x = static_cast<double>(id);
-  return morea::DualMesh{ { { { x, x + 0.25, -x } }, { { 1.0, 2.0, 3.0 } } }, { { { -x, x * 2.0, 0.5 } } } };
+  return morea_core::DualMesh{ { { { x, x + 0.25, -x } }, { { 1.0, 2.0, 3.0 } } }, { { { -x, x * 2.0, 0.5 } } } };
 }
 
 /** The archive's grid convention (ElitistArchive.cxx): cells centred on
@@ -64,7 +64,7 @@ DistanceToCellCorner(const ObjectiveVector & x, const ObjectiveVector & widths)
  *  overflowing and being re-discretised; the rest a little behind the surface
  *  (mostly dominated); some infeasible. */
 Fitness
-RandomCandidate(morea::RandomGenerator & random, double t, double shift)
+RandomCandidate(morea_core::RandomGenerator & random, double t, double shift)
 {
   const double radius = 0.1 + 1.4 * t; // in log space
   const double u = random.Uniform(-radius, radius);
@@ -92,7 +92,7 @@ ExpectMutuallyNonDominated(const ElitistArchive & archive)
     for (std::size_t k = 0; k < entries.size(); ++k)
       if (i != k)
       {
-        ASSERT_FALSE(morea::Dominates(entries[i].fitness.objectives, entries[k].fitness.objectives)) << i << " " << k;
+        ASSERT_FALSE(morea_core::Dominates(entries[i].fitness.objectives, entries[k].fitness.objectives)) << i << " " << k;
         ASSERT_NE(entries[i].fitness.objectives, entries[k].fitness.objectives) << i << " " << k;
       }
   }
@@ -113,13 +113,13 @@ ExpectOnePerCell(const ElitistArchive & archive)
 void
 InsertRandomly(ElitistArchive & archive, std::size_t count, std::uint64_t seed, double shift)
 {
-  morea::RandomGenerator random(seed);
+  morea_core::RandomGenerator random(seed);
   std::vector<Fitness>   candidates;
   for (std::uint64_t id = 0; id < count; ++id)
   {
     const Fitness f = RandomCandidate(random, static_cast<double>(id) / static_cast<double>(count), shift);
     candidates.push_back(f);
-    const std::vector<morea::ArchiveEntry> before = archive.Entries();
+    const std::vector<morea_core::ArchiveEntry> before = archive.Entries();
     const std::vector<std::uint64_t>       witnessesBefore = archive.Witnesses();
     const bool                            accepted = archive.Accepts(f);
     const bool                            inserted = archive.Insert(f, PayloadOf(id), id);
@@ -139,7 +139,7 @@ InsertRandomly(ElitistArchive & archive, std::size_t count, std::uint64_t seed, 
     // for a kept entry in its cell that lies no farther from the cell's corner.
     std::vector<ObjectiveVector> dropped;
     for (const auto & b : before)
-      if (find(b.id) == entries.end() && !morea::Dominates(f.objectives, b.fitness.objectives))
+      if (find(b.id) == entries.end() && !morea_core::Dominates(f.objectives, b.fitness.objectives))
         dropped.push_back(b.fitness.objectives);
     if (accepted && !inserted) // thinned out at once
       dropped.push_back(f.objectives);
@@ -151,7 +151,7 @@ InsertRandomly(ElitistArchive & archive, std::size_t count, std::uint64_t seed, 
         return CellOf(e.fitness.objectives, widths) == CellOf(x, widths);
       });
       ASSERT_NE(keeper, entries.end()) << id;
-      if (!morea::Dominates(keeper->fitness.objectives, x))
+      if (!morea_core::Dominates(keeper->fitness.objectives, x))
       {
         ASSERT_LE(DistanceToCellCorner(keeper->fitness.objectives, widths), DistanceToCellCorner(x, widths)) << id;
       }
@@ -173,7 +173,7 @@ InsertRandomly(ElitistArchive & archive, std::size_t count, std::uint64_t seed, 
       // or, when discretised, sharing a cell with one.
       const bool covered = std::any_of(entries.begin(), entries.end(), [&](const auto & e) {
         const ObjectiveVector & y = e.fitness.objectives;
-        return y == f.objectives || morea::Dominates(y, f.objectives) ||
+        return y == f.objectives || morea_core::Dominates(y, f.objectives) ||
                (archive.IsDiscretised() &&
                 CellOf(y, archive.CellWidths()) == CellOf(f.objectives, archive.CellWidths()));
       });
@@ -191,7 +191,7 @@ InsertRandomly(ElitistArchive & archive, std::size_t count, std::uint64_t seed, 
 
 TEST(ElitistArchive, RejectsZeroCapacity)
 {
-  EXPECT_THROW(ElitistArchive(0), morea::Error);
+  EXPECT_THROW(ElitistArchive(0), morea_core::Error);
 }
 
 TEST(ElitistArchive, InfeasibleNeverEnters)
@@ -237,7 +237,7 @@ TEST(ElitistArchive, DominatingPointRemovesDominatedOnes)
 TEST(ElitistArchive, StoresThePayloadIntact)
 {
   ElitistArchive        archive(10);
-  const morea::DualMesh solution{ { { { 1.5, -2.0, 3.25 } }, { { 4, 5, 6 } }, { { 7, 8, 9 } } },
+  const morea_core::DualMesh solution{ { { { 1.5, -2.0, 3.25 } }, { { 4, 5, 6 } }, { { 7, 8, 9 } } },
                                   { { { 0.1, 0.2, 0.3 } }, { { -4, -5, -6 } }, { { 1e9, -1e-9, 0 } } } };
   const Fitness         f = Feasible(1, 2, 3);
   ASSERT_TRUE(archive.Insert(f, solution, 123456789012345ULL));
@@ -301,7 +301,7 @@ TEST(ElitistArchive, DiscretisedCellAdmitsOnlyADominatingNewcomer)
 {
   // Widths so wide that all these points share one cell.
   ElitistArchive archive(10);
-  archive.Restore({ morea::ArchiveEntry{ Feasible(0.2, 0.6, 0.5), PayloadOf(1), 1 } }, true, { { 1000, 1000, 1000 } });
+  archive.Restore({ morea_core::ArchiveEntry{ Feasible(0.2, 0.6, 0.5), PayloadOf(1), 1 } }, true, { { 1000, 1000, 1000 } });
   // Non-dominated but in the occupied cell without dominating its entry: refused.
   EXPECT_FALSE(archive.Accepts(Feasible(0.3, 0.5, 0.5)));
   EXPECT_FALSE(archive.Insert(Feasible(0.3, 0.5, 0.5), PayloadOf(2), 2));
@@ -333,7 +333,7 @@ TEST(ElitistArchive, RestoreRoundTrip)
     EXPECT_EQ(restored.Entries()[i].solution.target, original.Entries()[i].solution.target);
   }
   // Both answer and evolve alike.
-  morea::RandomGenerator random(77);
+  morea_core::RandomGenerator random(77);
   std::size_t            accepted = 0;
   for (std::uint64_t id = 0; id < 2000; ++id)
   {
@@ -347,7 +347,7 @@ TEST(ElitistArchive, RestoreRoundTrip)
   EXPECT_EQ(restored.CellWidths(), original.CellWidths());
 
   ElitistArchive tooSmall(original.Size() - 1);
-  EXPECT_THROW(tooSmall.Restore(original.Entries(), true, original.CellWidths()), morea::Error);
+  EXPECT_THROW(tooSmall.Restore(original.Entries(), true, original.CellWidths()), morea_core::Error);
 }
 
 TEST(ElitistArchive, RemoveIf)
@@ -355,7 +355,7 @@ TEST(ElitistArchive, RemoveIf)
   ElitistArchive archive(10);
   for (std::uint64_t i = 0; i < 5; ++i)
     archive.Insert(Feasible(static_cast<double>(i), 4.0 - static_cast<double>(i), 0.0), PayloadOf(i), i);
-  archive.RemoveIf([](const morea::ArchiveEntry & e) { return e.fitness.objectives[0] >= 2.5; });
+  archive.RemoveIf([](const morea_core::ArchiveEntry & e) { return e.fitness.objectives[0] >= 2.5; });
   ASSERT_EQ(archive.Size(), 3u);
   for (std::uint64_t i = 0; i < 3; ++i)
   {
@@ -375,15 +375,15 @@ RejectedByDominance(const ElitistArchive & archive, const Fitness & f)
 {
   if (!f.feasible || !std::all_of(f.objectives.begin(), f.objectives.end(), [](double x) { return std::isfinite(x); }))
     return true;
-  return std::any_of(archive.Entries().begin(), archive.Entries().end(), [&](const morea::ArchiveEntry & e) {
-    return e.fitness.objectives == f.objectives || morea::Dominates(e.fitness.objectives, f.objectives);
+  return std::any_of(archive.Entries().begin(), archive.Entries().end(), [&](const morea_core::ArchiveEntry & e) {
+    return e.fitness.objectives == f.objectives || morea_core::Dominates(e.fitness.objectives, f.objectives);
   });
 }
 
 /** Probes for verdicts: random candidates (some equal to an entry, some
  *  non-finite). */
 Fitness
-RandomProbe(morea::RandomGenerator & random, const ElitistArchive & archive)
+RandomProbe(morea_core::RandomGenerator & random, const ElitistArchive & archive)
 {
   const double u = random.Uniform();
   if (u < 0.05 && archive.Size() > 0)
@@ -398,7 +398,7 @@ ElitistArchive
 FilledArchive(std::size_t capacity, std::size_t insertions, std::uint64_t seed)
 {
   ElitistArchive         archive(capacity);
-  morea::RandomGenerator random(seed);
+  morea_core::RandomGenerator random(seed);
   for (std::uint64_t id = 0; id < insertions; ++id)
     archive.Insert(RandomCandidate(random, static_cast<double>(id) / static_cast<double>(insertions), 0.0),
                    PayloadOf(id), id);
@@ -413,19 +413,19 @@ TEST(ElitistArchive, JudgeAgreesWithAFullScan)
   {
     const ElitistArchive archive = FilledArchive(capacity, 1500, 5 + capacity);
     ASSERT_EQ(archive.IsDiscretised(), capacity == 60);
-    morea::RandomGenerator random(11);
+    morea_core::RandomGenerator random(11);
     std::size_t            kinds[4] = {};
-    morea::ArchiveVerdict  previous;
+    morea_core::ArchiveVerdict  previous;
     for (int i = 0; i < 4000; ++i)
     {
       const Fitness               f = RandomProbe(random, archive);
-      const morea::ArchiveVerdict verdict = archive.Judge(f);
+      const morea_core::ArchiveVerdict verdict = archive.Judge(f);
       const bool                  accepts = archive.Accepts(f);
       ++kinds[static_cast<int>(verdict.kind)];
-      EXPECT_EQ(verdict.kind == morea::ArchiveVerdict::Kind::Accepted, accepts) << i;
-      EXPECT_EQ(verdict.kind == morea::ArchiveVerdict::Kind::Rejected, RejectedByDominance(archive, f)) << i;
-      EXPECT_NE(verdict.kind, morea::ArchiveVerdict::Kind::Unknown) << i;
-      if (verdict.kind == morea::ArchiveVerdict::Kind::Crowded)
+      EXPECT_EQ(verdict.kind == morea_core::ArchiveVerdict::Kind::Accepted, accepts) << i;
+      EXPECT_EQ(verdict.kind == morea_core::ArchiveVerdict::Kind::Rejected, RejectedByDominance(archive, f)) << i;
+      EXPECT_NE(verdict.kind, morea_core::ArchiveVerdict::Kind::Unknown) << i;
+      if (verdict.kind == morea_core::ArchiveVerdict::Kind::Crowded)
       {
         // Refused by the cell of an entry here, which it does not dominate.
         EXPECT_TRUE(archive.IsDiscretised()) << i;
@@ -435,8 +435,8 @@ TEST(ElitistArchive, JudgeAgreesWithAFullScan)
           std::find(witnesses.begin(), witnesses.end(), verdict.witness) - witnesses.begin())];
         EXPECT_EQ(CellOf(holder.fitness.objectives, archive.CellWidths()), CellOf(f.objectives, archive.CellWidths()))
           << i;
-        EXPECT_FALSE(morea::Dominates(f.objectives, holder.fitness.objectives)) << i;
-        morea::ArchiveVerdict copy = verdict;
+        EXPECT_FALSE(morea_core::Dominates(f.objectives, holder.fitness.objectives)) << i;
+        morea_core::ArchiveVerdict copy = verdict;
         EXPECT_FALSE(archive.Accepts(f, copy)) << i;
       }
       EXPECT_EQ(verdict.revision, archive.ThinningRevision());
@@ -444,17 +444,17 @@ TEST(ElitistArchive, JudgeAgreesWithAFullScan)
       EXPECT_EQ(archive.Judge(f, previous.witness).kind, verdict.kind) << i;
       EXPECT_EQ(archive.Judge(f, random.NextU64() % 2000).kind, verdict.kind) << i;
       // So does Accepts() from a verdict that knows nothing, or only a witness.
-      morea::ArchiveVerdict blank;
+      morea_core::ArchiveVerdict blank;
       EXPECT_EQ(archive.Accepts(f, blank), accepts) << i;
-      morea::ArchiveVerdict hinted = previous;
-      hinted.kind = morea::ArchiveVerdict::Kind::Unknown;
+      morea_core::ArchiveVerdict hinted = previous;
+      hinted.kind = morea_core::ArchiveVerdict::Kind::Unknown;
       EXPECT_EQ(archive.Accepts(f, hinted), accepts) << i;
       previous = verdict;
     }
     // All kinds came up (Crowded only with a grid).
-    EXPECT_GT(kinds[static_cast<int>(morea::ArchiveVerdict::Kind::Rejected)], 100u) << capacity;
-    EXPECT_GT(kinds[static_cast<int>(morea::ArchiveVerdict::Kind::Accepted)], 100u) << capacity;
-    EXPECT_EQ(kinds[static_cast<int>(morea::ArchiveVerdict::Kind::Crowded)] > 0, archive.IsDiscretised()) << capacity;
+    EXPECT_GT(kinds[static_cast<int>(morea_core::ArchiveVerdict::Kind::Rejected)], 100u) << capacity;
+    EXPECT_GT(kinds[static_cast<int>(morea_core::ArchiveVerdict::Kind::Accepted)], 100u) << capacity;
+    EXPECT_EQ(kinds[static_cast<int>(morea_core::ArchiveVerdict::Kind::Crowded)] > 0, archive.IsDiscretised()) << capacity;
   }
 }
 
@@ -469,7 +469,7 @@ TEST(ElitistArchive, JudgeNamesTheFirstRefusingEntry)
       const ElitistArchive archive = FilledArchive(capacity, insertions, 3 + capacity + insertions);
       const auto           witnesses = archive.Witnesses();
       const auto &         entries = archive.Entries();
-      morea::RandomGenerator random(insertions);
+      morea_core::RandomGenerator random(insertions);
       std::size_t            checked = 0;
       for (int i = 0; i < 2000; ++i)
       {
@@ -481,27 +481,27 @@ TEST(ElitistArchive, JudgeNamesTheFirstRefusingEntry)
         for (std::size_t e = 0; e < entries.size() && dominance == entries.size(); ++e)
         {
           const ObjectiveVector & y = entries[e].fitness.objectives;
-          if (y == f.objectives || morea::Dominates(y, f.objectives))
+          if (y == f.objectives || morea_core::Dominates(y, f.objectives))
             dominance = e;
           else if (crowding == entries.size() && archive.IsDiscretised() &&
                    CellOf(y, archive.CellWidths()) == CellOf(f.objectives, archive.CellWidths()) &&
-                   !morea::Dominates(f.objectives, y))
+                   !morea_core::Dominates(f.objectives, y))
             crowding = e;
         }
         // A witness no entry has: no hint.
-        const morea::ArchiveVerdict verdict = archive.Judge(f, std::numeric_limits<std::uint64_t>::max());
+        const morea_core::ArchiveVerdict verdict = archive.Judge(f, std::numeric_limits<std::uint64_t>::max());
         if (dominance < entries.size())
         {
-          ASSERT_EQ(verdict.kind, morea::ArchiveVerdict::Kind::Rejected) << i;
+          ASSERT_EQ(verdict.kind, morea_core::ArchiveVerdict::Kind::Rejected) << i;
           ASSERT_EQ(verdict.witness, witnesses[dominance]) << i;
         }
         else if (crowding < entries.size())
         {
-          ASSERT_EQ(verdict.kind, morea::ArchiveVerdict::Kind::Crowded) << i;
+          ASSERT_EQ(verdict.kind, morea_core::ArchiveVerdict::Kind::Crowded) << i;
           ASSERT_EQ(verdict.witness, witnesses[crowding]) << i;
         }
         else
-          ASSERT_EQ(verdict.kind, morea::ArchiveVerdict::Kind::Accepted) << i;
+          ASSERT_EQ(verdict.kind, morea_core::ArchiveVerdict::Kind::Accepted) << i;
         ++checked;
       }
       EXPECT_GT(checked, 1500u);
@@ -512,11 +512,11 @@ TEST(ElitistArchive, RestoreRefusesNonFiniteObjectives)
 {
   ElitistArchive original(100);
   InsertRandomly(original, 50, 2, 0.0);
-  std::vector<morea::ArchiveEntry> entries = original.Entries();
+  std::vector<morea_core::ArchiveEntry> entries = original.Entries();
   ASSERT_FALSE(entries.empty());
   entries.back().fitness.objectives[2] = std::numeric_limits<double>::quiet_NaN();
   ElitistArchive restored(100);
-  EXPECT_THROW(restored.Restore(entries, false, ObjectiveVector{ 0.0, 0.0, 0.0 }), morea::Error);
+  EXPECT_THROW(restored.Restore(entries, false, ObjectiveVector{ 0.0, 0.0, 0.0 }), morea_core::Error);
   EXPECT_EQ(restored.Size(), 0u); // nothing half-restored
 }
 
@@ -526,9 +526,9 @@ TEST(ElitistArchive, RejectionsByDominanceOutlastInsertionsWithoutThinning)
   // them, which then dominates what they dominated.
   ElitistArchive                     archive = FilledArchive(100000, 300, 3);
   const std::uint64_t                revision = archive.ThinningRevision();
-  morea::RandomGenerator             random(4);
+  morea_core::RandomGenerator             random(4);
   std::vector<Fitness>               probes;
-  std::vector<morea::ArchiveVerdict> verdicts;
+  std::vector<morea_core::ArchiveVerdict> verdicts;
   for (int i = 0; i < 1500; ++i)
   {
     probes.push_back(RandomProbe(random, archive));
@@ -537,12 +537,12 @@ TEST(ElitistArchive, RejectionsByDominanceOutlastInsertionsWithoutThinning)
   // For the rejected probes: the entries that then equalled or dominated them.
   std::vector<std::vector<std::uint64_t>> coveredBy(probes.size());
   for (std::size_t i = 0; i < probes.size(); ++i)
-    if (verdicts[i].kind == morea::ArchiveVerdict::Kind::Rejected)
+    if (verdicts[i].kind == morea_core::ArchiveVerdict::Kind::Rejected)
       for (const auto & e : archive.Entries())
-        if (e.fitness.objectives == probes[i].objectives || morea::Dominates(e.fitness.objectives, probes[i].objectives))
+        if (e.fitness.objectives == probes[i].objectives || morea_core::Dominates(e.fitness.objectives, probes[i].objectives))
           coveredBy[i].push_back(e.id);
 
-  std::vector<morea::ArchiveVerdict> live = verdicts; // brought up to date on every call
+  std::vector<morea_core::ArchiveVerdict> live = verdicts; // brought up to date on every call
   std::size_t                        removed = 0;
   for (std::uint64_t id = 1000; id < 2500; ++id)
   {
@@ -558,9 +558,9 @@ TEST(ElitistArchive, RejectionsByDominanceOutlastInsertionsWithoutThinning)
     {
       const std::size_t i = static_cast<std::size_t>(random.Uniform() * static_cast<double>(probes.size()));
       const bool        accepts = archive.Accepts(probes[i]);
-      if (verdicts[i].kind == morea::ArchiveVerdict::Kind::Rejected)
+      if (verdicts[i].kind == morea_core::ArchiveVerdict::Kind::Rejected)
         ASSERT_FALSE(accepts) << id << " " << i;
-      morea::ArchiveVerdict snapshot = verdicts[i];
+      morea_core::ArchiveVerdict snapshot = verdicts[i];
       ASSERT_EQ(archive.Accepts(probes[i], snapshot), accepts) << id << " " << i;
       ASSERT_EQ(archive.Accepts(probes[i], live[i]), accepts) << id << " " << i;
     }
@@ -573,7 +573,7 @@ TEST(ElitistArchive, RejectionsByDominanceOutlastInsertionsWithoutThinning)
   for (std::size_t i = 0; i < probes.size(); ++i)
     if (!coveredBy[i].empty() && std::none_of(coveredBy[i].begin(), coveredBy[i].end(), [&](std::uint64_t id) {
           return std::any_of(archive.Entries().begin(), archive.Entries().end(),
-                             [&](const morea::ArchiveEntry & e) { return e.id == id; });
+                             [&](const morea_core::ArchiveEntry & e) { return e.id == id; });
         }))
     {
       ++outlived;
@@ -586,7 +586,7 @@ TEST(ElitistArchive, RejectionsByDominanceOutlastInsertionsWithoutThinning)
 TEST(ElitistArchive, ThinningRevisionCountsThinningRemovalAndRestore)
 {
   ElitistArchive         archive(20);
-  morea::RandomGenerator random(8);
+  morea_core::RandomGenerator random(8);
   std::size_t            thinnings = 0, quiet = 0;
   for (std::uint64_t id = 0; id < 1500; ++id)
   {
@@ -596,7 +596,7 @@ TEST(ElitistArchive, ThinningRevisionCountsThinningRemovalAndRestore)
     const bool          accepts = archive.Accepts(f);
     std::size_t         dominated = 0;
     for (const auto & e : before)
-      dominated += accepts && morea::Dominates(f.objectives, e.fitness.objectives);
+      dominated += accepts && morea_core::Dominates(f.objectives, e.fitness.objectives);
     archive.Insert(f, PayloadOf(id), id);
     // Thinned exactly when the newcomer would overfill the archive.
     const bool overfull = accepts && before.size() - dominated + 1 > archive.Capacity();
@@ -612,7 +612,7 @@ TEST(ElitistArchive, ThinningRevisionCountsThinningRemovalAndRestore)
       ++quiet;
       std::vector<ObjectiveVector> expected;
       for (const auto & e : before)
-        if (!accepts || !morea::Dominates(f.objectives, e.fitness.objectives))
+        if (!accepts || !morea_core::Dominates(f.objectives, e.fitness.objectives))
           expected.push_back(e.fitness.objectives);
       if (accepts)
         expected.push_back(f.objectives);
@@ -623,7 +623,7 @@ TEST(ElitistArchive, ThinningRevisionCountsThinningRemovalAndRestore)
   EXPECT_GT(quiet, 100u);
 
   std::uint64_t revision = archive.ThinningRevision();
-  archive.RemoveIf([](const morea::ArchiveEntry & e) { return e.id % 2 == 0; });
+  archive.RemoveIf([](const morea_core::ArchiveEntry & e) { return e.id % 2 == 0; });
   EXPECT_EQ(archive.ThinningRevision(), ++revision);
   archive.Restore(archive.Entries(), archive.IsDiscretised(), archive.CellWidths());
   EXPECT_EQ(archive.ThinningRevision(), ++revision);
@@ -638,7 +638,7 @@ TEST(ElitistArchive, VerdictsGiveTheAnswersOfFullScans)
   for (std::size_t capacity : { 100000, 40 })
   {
     ElitistArchive         plain(capacity), judged(capacity);
-    morea::RandomGenerator random(21 + capacity);
+    morea_core::RandomGenerator random(21 + capacity);
     std::uint64_t          id = 0;
     std::size_t            viaVerdicts = 0;
     for (int batch = 0; batch < 40; ++batch)
@@ -646,7 +646,7 @@ TEST(ElitistArchive, VerdictsGiveTheAnswersOfFullScans)
       std::vector<Fitness> batchFitness;
       for (int k = 0; k < 150; ++k)
         batchFitness.push_back(RandomCandidate(random, static_cast<double>(batch) / 40.0, 0.0));
-      std::vector<morea::ArchiveVerdict> verdicts;
+      std::vector<morea_core::ArchiveVerdict> verdicts;
       std::uint64_t                      witness = 0;
       for (const Fitness & f : batchFitness)
       {
@@ -661,7 +661,7 @@ TEST(ElitistArchive, VerdictsGiveTheAnswersOfFullScans)
         if (b == batchFitness.size() / 2 && batch % 5 == 4)
         {
           const double limit = 1.2 + random.Uniform();
-          auto         steer = [limit](const morea::ArchiveEntry & e) { return e.fitness.objectives[2] > limit; };
+          auto         steer = [limit](const morea_core::ArchiveEntry & e) { return e.fitness.objectives[2] > limit; };
           plain.RemoveIf(steer);
           judged.RemoveIf(steer);
         }
@@ -672,9 +672,9 @@ TEST(ElitistArchive, VerdictsGiveTheAnswersOfFullScans)
         {
           // Its solution changed since: the verdict is on another fitness.
           f.objectives[0] *= 0.999;
-          verdicts[b].kind = morea::ArchiveVerdict::Kind::Unknown;
+          verdicts[b].kind = morea_core::ArchiveVerdict::Kind::Unknown;
         }
-        viaVerdicts += verdicts[b].kind != morea::ArchiveVerdict::Kind::Unknown && judged.ThinningRevision() == revision;
+        viaVerdicts += verdicts[b].kind != morea_core::ArchiveVerdict::Kind::Unknown && judged.ThinningRevision() == revision;
         const bool accepts = plain.Accepts(f);
         ASSERT_EQ(judged.Accepts(f, verdicts[b]), accepts) << capacity << " " << batch << " " << b;
         // Inserted when accepted, or (like a candidate that dominates its

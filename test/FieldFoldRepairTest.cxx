@@ -1,9 +1,9 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/FieldFoldRepair.h"
+#include "morea_core/FieldFoldRepair.h"
 
-#include "morea/Error.h"
-#include "morea/MeshRasterizer.h"
+#include "morea_core/Error.h"
+#include "morea_core/MeshRasterizer.h"
 
 #include "BoxMesh.h"
 
@@ -14,8 +14,8 @@
 
 namespace
 {
-using morea::Vec3;
-using morea::Volume;
+using morea_core::Vec3;
+using morea_core::Volume;
 
 Volume<Vec3>
 Grid(std::array<std::size_t, 3> size, Vec3 spacing)
@@ -49,11 +49,11 @@ TEST(FieldFoldRepair, AffineFieldDeterminantIsExactEverywhere)
   for (std::size_t k = 0; k < 4; ++k)
     for (std::size_t j = 0; j < 5; ++j)
       for (std::size_t i = 0; i < 6; ++i)
-        EXPECT_NEAR(morea::JacobianDeterminantAt(field, i, j, k), expected, 1e-12) << i << "," << j << "," << k;
-  EXPECT_EQ(morea::CountNonPositiveJacobians(field), 0u);
+        EXPECT_NEAR(morea_core::JacobianDeterminantAt(field, i, j, k), expected, 1e-12) << i << "," << j << "," << k;
+  EXPECT_EQ(morea_core::CountNonPositiveJacobians(field), 0u);
 
   const auto before = field.data;
-  const auto report = morea::RemoveVoxelFolds(field);
+  const auto report = morea_core::RemoveVoxelFolds(field);
   EXPECT_EQ(report.foldedBefore, 0u);
   EXPECT_EQ(report.voxelsChanged, 0u);
   EXPECT_EQ(report.iterations, 0u);
@@ -68,8 +68,8 @@ TEST(FieldFoldRepair, ReflectionCountsEveryVoxel)
     for (std::size_t j = 0; j < 3; ++j)
       for (std::size_t i = 0; i < 4; ++i)
         field(i, j, k) = { { -2.0 * field.PointAt(i, j, k)[0], 0.0, 0.0 } };
-  EXPECT_NEAR(morea::JacobianDeterminantAt(field, 1, 1, 1), -1.0, 1e-12);
-  EXPECT_EQ(morea::CountNonPositiveJacobians(field), field.NumberOfVoxels());
+  EXPECT_NEAR(morea_core::JacobianDeterminantAt(field, 1, 1, 1), -1.0, 1e-12);
+  EXPECT_EQ(morea_core::CountNonPositiveJacobians(field), field.NumberOfVoxels());
 }
 
 TEST(FieldFoldRepair, LocalSpikeIsSmoothedAwayAndTheRestIsKept)
@@ -84,13 +84,13 @@ TEST(FieldFoldRepair, LocalSpikeIsSmoothedAwayAndTheRestIsKept)
   field(10, 10, 10)[0] += 2.5;
   field(10, 11, 10)[0] -= 2.5;
   const auto before = field.data;
-  const std::size_t folded = morea::CountNonPositiveJacobians(field);
+  const std::size_t folded = morea_core::CountNonPositiveJacobians(field);
   ASSERT_GT(folded, 0u);
 
-  const auto report = morea::RemoveVoxelFolds(field);
+  const auto report = morea_core::RemoveVoxelFolds(field);
   EXPECT_EQ(report.foldedBefore, folded);
   EXPECT_EQ(report.foldedAfter, 0u);
-  EXPECT_EQ(morea::CountNonPositiveJacobians(field), 0u);
+  EXPECT_EQ(morea_core::CountNonPositiveJacobians(field), 0u);
   EXPECT_GT(report.iterations, 0u);
   EXPECT_GT(report.voxelsChanged, 0u);
   EXPECT_LT(report.voxelsChanged, 1000u) << "the repair stays local";
@@ -119,20 +119,20 @@ TEST(FieldFoldRepair, CompressedTetrahedraOfAFoldFreeMeshAreRepaired)
   // finite-difference determinant goes negative. (Perturbation and seed were
   // picked so that this happens: 7 folded voxels.)
   Volume<Vec3> grid({ { 25, 25, 25 } }, { { 1.0, 1.0, 1.0 } }, { { 0.0, 0.0, 0.0 } });
-  const auto   box = morea_test::MakeBoxMesh(morea::MeshDomain::OfGrid(grid), { { 3, 3, 3 } });
-  const morea::MeshTopology topology(box.tetrahedra, box.points.size());
+  const auto   box = morea_test::MakeBoxMesh(morea_core::MeshDomain::OfGrid(grid), { { 3, 3, 3 } });
+  const morea_core::MeshTopology topology(box.tetrahedra, box.points.size());
   const auto                moved = morea_test::Perturb(box, 0.45, 115);
   ASSERT_GT(morea_test::MinimumSignedVolume(box.tetrahedra, moved), 0.0) << "the mesh map itself is fold-free";
 
-  morea::RasterizeDisplacement(topology, box.points, moved, grid);
-  const std::size_t folded = morea::CountNonPositiveJacobians(grid);
+  morea_core::RasterizeDisplacement(topology, box.points, moved, grid);
+  const std::size_t folded = morea_core::CountNonPositiveJacobians(grid);
   ASSERT_GT(folded, 0u) << "the test needs a field that folds at voxel level";
   const auto before = grid.data;
 
-  const auto report = morea::RemoveVoxelFolds(grid);
+  const auto report = morea_core::RemoveVoxelFolds(grid);
   EXPECT_EQ(report.foldedBefore, folded);
   EXPECT_EQ(report.foldedAfter, 0u);
-  EXPECT_EQ(morea::CountNonPositiveJacobians(grid), 0u);
+  EXPECT_EQ(morea_core::CountNonPositiveJacobians(grid), 0u);
   std::size_t changed{ 0 };
   for (std::size_t o = 0; o < grid.NumberOfVoxels(); ++o)
     changed += grid.data[o] != before[o];
@@ -150,20 +150,20 @@ TEST(FieldFoldRepair, GivesUpAfterTheIterationLimitAndSaysSo)
     for (std::size_t j = 0; j < 8; ++j)
       for (std::size_t i = 0; i < 8; ++i)
         field(i, j, k) = { { -2.0 * field.PointAt(i, j, k)[0], 0.0, 0.0 } };
-  morea::FieldFoldRepairOptions options;
+  morea_core::FieldFoldRepairOptions options;
   options.maximumIterations = 3;
-  const auto report = morea::RemoveVoxelFolds(field, options);
+  const auto report = morea_core::RemoveVoxelFolds(field, options);
   EXPECT_EQ(report.iterations, 3u);
   EXPECT_EQ(report.foldedBefore, field.NumberOfVoxels());
   EXPECT_GT(report.foldedAfter, 0u);
-  EXPECT_EQ(report.foldedAfter, morea::CountNonPositiveJacobians(field));
+  EXPECT_EQ(report.foldedAfter, morea_core::CountNonPositiveJacobians(field));
 }
 
 TEST(FieldFoldRepair, RejectsBadFields)
 {
   Volume<Vec3> empty;
-  EXPECT_THROW(morea::RemoveVoxelFolds(empty), morea::Error);
+  EXPECT_THROW(morea_core::RemoveVoxelFolds(empty), morea_core::Error);
   auto field = Grid({ { 3, 3, 3 } }, { { 1.0, 0.0, 1.0 } });
-  EXPECT_THROW(morea::RemoveVoxelFolds(field), morea::Error);
-  EXPECT_THROW(morea::CountNonPositiveJacobians(field), morea::Error);
+  EXPECT_THROW(morea_core::RemoveVoxelFolds(field), morea_core::Error);
+  EXPECT_THROW(morea_core::CountNonPositiveJacobians(field), morea_core::Error);
 }

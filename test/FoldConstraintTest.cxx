@@ -3,9 +3,9 @@
 // Tests of fold detection, the constraint value and the Gaussian repair.
 #include "MeshTestSupport.h"
 
-#include "morea/Error.h"
-#include "morea/FoldConstraint.h"
-#include "morea/MeshRepair.h"
+#include "morea_core/Error.h"
+#include "morea_core/FoldConstraint.h"
+#include "morea_core/MeshRepair.h"
 
 #include <gtest/gtest.h>
 
@@ -13,21 +13,21 @@
 
 namespace
 {
-using morea::Vec3;
+using morea_core::Vec3;
 
 // Two tetrahedra on the triangle (0,1,2) in the plane z = 0: point 3 above,
 // point 4 below. Area of the triangle: 8.
 struct TwoTetrahedra
 {
   std::vector<Vec3>              points{ { { 0, 0, 0 } }, { { 4, 0, 0 } }, { { 0, 4, 0 } }, { { 1, 1, 3 } }, { { 1, 1, -2 } } };
-  std::vector<morea::Tetrahedron> tets{ { { 0, 1, 2, 3 } }, { { 0, 2, 1, 4 } } };
-  morea::MeshTopology            topology{ tets, 5 };
+  std::vector<morea_core::Tetrahedron> tets{ { { 0, 1, 2, 3 } }, { { 0, 2, 1, 4 } } };
+  morea_core::MeshTopology            topology{ tets, 5 };
 };
 
 TEST(FoldConstraint, PlantedFoldHasTheRightSeverity)
 {
   TwoTetrahedra         m;
-  morea::FoldConstraint constraint(m.topology, m.points);
+  morea_core::FoldConstraint constraint(m.topology, m.points);
   EXPECT_TRUE(constraint.Evaluate(m.points).Feasible());
   EXPECT_EQ(constraint.Evaluate(m.points).value, 0.0);
 
@@ -45,7 +45,7 @@ TEST(FoldConstraint, PlantedFoldHasTheRightSeverity)
   EXPECT_EQ(constraint.Evaluate(folded).value, 0.0);
 
   // Both meshes add up.
-  morea::DualMesh dual{ m.points, m.points };
+  morea_core::DualMesh dual{ m.points, m.points };
   dual.target[3] = { { 1, 1, -1.5 } };
   dual.source[4] = { { 1, 1, 0.5 } }; // |volume| = 8 * 0.5 / 3
   const auto both = constraint.Evaluate(dual);
@@ -56,19 +56,19 @@ TEST(FoldConstraint, PlantedFoldHasTheRightSeverity)
 TEST(FoldConstraint, RejectsMismatchedSizesAndFlatReference)
 {
   TwoTetrahedra m;
-  EXPECT_THROW(morea::FoldConstraint(m.topology, { m.points[0] }), morea::Error);
+  EXPECT_THROW(morea_core::FoldConstraint(m.topology, { m.points[0] }), morea_core::Error);
   auto flat = m.points;
   flat[3][2] = 0.0;
-  EXPECT_THROW(morea::FoldConstraint(m.topology, flat), morea::Error);
-  morea::FoldConstraint constraint(m.topology, m.points);
-  EXPECT_THROW(constraint.Evaluate(std::vector<Vec3>(3)), morea::Error);
+  EXPECT_THROW(morea_core::FoldConstraint(m.topology, flat), morea_core::Error);
+  morea_core::FoldConstraint constraint(m.topology, m.points);
+  EXPECT_THROW(constraint.Evaluate(std::vector<Vec3>(3)), morea_core::Error);
 }
 
 TEST(FoldConstraint, TranslatedPhantomMeshHasNoFold)
 {
   const auto &              pm = morea_test::PhantomMesh600();
-  const morea::MeshTopology topology(pm.mesh.tetrahedra, pm.mesh.NumberOfPoints());
-  morea::FoldConstraint     constraint(topology, pm.mesh.points);
+  const morea_core::MeshTopology topology(pm.mesh.tetrahedra, pm.mesh.NumberOfPoints());
+  morea_core::FoldConstraint     constraint(topology, pm.mesh.points);
   for (const Vec3 shift : { Vec3{ { 12.5, -3.0, 40.0 } }, Vec3{ { -0.001, 0.0, 0.0 } } })
   {
     std::vector<Vec3> moved = pm.mesh.points;
@@ -84,13 +84,13 @@ TEST(FoldConstraint, TranslatedPhantomMeshHasNoFold)
 /** Moves an inner point of the phantom mesh through the face opposite it in
  *  one of its tetrahedra (mirrors it in that face's plane). */
 std::uint32_t
-PlantFold(std::vector<Vec3> & points, const morea::TetrahedralMesh & mesh, const morea::MeshTopology & topology,
+PlantFold(std::vector<Vec3> & points, const morea_core::TetrahedralMesh & mesh, const morea_core::MeshTopology & topology,
           std::size_t which)
 {
   std::size_t seen = 0;
   for (std::uint32_t p = 0; p < points.size(); ++p)
   {
-    if (mesh.origins[p] != morea::PointOrigin::Random || seen++ != which)
+    if (mesh.origins[p] != morea_core::PointOrigin::Random || seen++ != which)
       continue;
     const auto & tet = topology.Tetrahedra()[*topology.TetrahedraOfPointBegin(p)];
     Vec3         f[3];
@@ -116,8 +116,8 @@ PlantFold(std::vector<Vec3> & points, const morea::TetrahedralMesh & mesh, const
 TEST(FoldConstraint, PartialEvaluationMatchesFullOnThePhantomMesh)
 {
   const auto &              pm = morea_test::PhantomMesh600();
-  const morea::MeshTopology topology(pm.mesh.tetrahedra, pm.mesh.NumberOfPoints());
-  morea::FoldConstraint     constraint(topology, pm.mesh.points);
+  const morea_core::MeshTopology topology(pm.mesh.tetrahedra, pm.mesh.NumberOfPoints());
+  morea_core::FoldConstraint     constraint(topology, pm.mesh.points);
   std::vector<Vec3>         before = pm.mesh.points;
   std::vector<Vec3>         after = before;
   const std::uint32_t       p = PlantFold(after, pm.mesh, topology, 3);
@@ -136,9 +136,9 @@ TEST(FoldConstraint, PartialEvaluationMatchesFullOnThePhantomMesh)
 TEST(MeshRepair, RepairsPlantedFoldsInBothMeshes)
 {
   const auto &              pm = morea_test::PhantomMesh600();
-  const morea::MeshTopology topology(pm.mesh.tetrahedra, pm.mesh.NumberOfPoints());
-  morea::FoldConstraint     constraint(topology, pm.mesh.points);
-  morea::DualMesh           solution = morea::DualMesh::FromBase(pm.mesh);
+  const morea_core::MeshTopology topology(pm.mesh.tetrahedra, pm.mesh.NumberOfPoints());
+  morea_core::FoldConstraint     constraint(topology, pm.mesh.points);
+  morea_core::DualMesh           solution = morea_core::DualMesh::FromBase(pm.mesh);
   for (std::size_t k : { 0, 5, 11 })
     PlantFold(solution.target, pm.mesh, topology, k);
   PlantFold(solution.source, pm.mesh, topology, 20);
@@ -146,13 +146,13 @@ TEST(MeshRepair, RepairsPlantedFoldsInBothMeshes)
 
   // The repair is stochastic: over several seeds it always lowers the
   // violation, usually removes every fold, and keeps points on their faces.
-  const morea::DualMesh planted = solution;
+  const morea_core::DualMesh planted = solution;
   std::size_t           repaired = 0;
   for (std::uint64_t seed = 0; seed < 20; ++seed)
   {
     solution = planted;
-    morea::RandomGenerator random(seed);
-    const auto             result = morea::RepairFolds(solution, pm.mesh, constraint, random);
+    morea_core::RandomGenerator random(seed);
+    const auto             result = morea_core::RepairFolds(solution, pm.mesh, constraint, random);
     EXPECT_GE(result.before.folded, 4u);
     EXPECT_LT(result.after.folded, result.before.folded) << "seed " << seed;
     EXPECT_LT(result.after.value, result.before.value) << "seed " << seed;
@@ -162,16 +162,16 @@ TEST(MeshRepair, RepairsPlantedFoldsInBothMeshes)
     repaired += result.Repaired();
     for (std::size_t i = 0; i < solution.source.size(); ++i)
     {
-      EXPECT_EQ(morea::ProjectToDomain(solution.source[i], pm.mesh.pins[i], pm.domain), solution.source[i]);
-      EXPECT_EQ(morea::ProjectToDomain(solution.target[i], pm.mesh.pins[i], pm.domain), solution.target[i]);
+      EXPECT_EQ(morea_core::ProjectToDomain(solution.source[i], pm.mesh.pins[i], pm.domain), solution.source[i]);
+      EXPECT_EQ(morea_core::ProjectToDomain(solution.target[i], pm.mesh.pins[i], pm.domain), solution.target[i]);
     }
   }
   EXPECT_GE(repaired, 6u) << "of 20 seeds";
 
   // A fold-free mesh is left untouched.
-  morea::DualMesh untouched = morea::DualMesh::FromBase(pm.mesh);
-  morea::RandomGenerator random(42);
-  const auto      none = morea::RepairFolds(untouched, pm.mesh, constraint, random);
+  morea_core::DualMesh untouched = morea_core::DualMesh::FromBase(pm.mesh);
+  morea_core::RandomGenerator random(42);
+  const auto      none = morea_core::RepairFolds(untouched, pm.mesh, constraint, random);
   EXPECT_EQ(none.movedPoints, 0u);
   EXPECT_EQ(untouched.target, pm.mesh.points);
 }

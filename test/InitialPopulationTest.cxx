@@ -3,8 +3,8 @@
 // Tests of the initial population: fold-free, diverse, reproducible.
 #include "MeshTestSupport.h"
 
-#include "morea/InitialPopulation.h"
-#include "morea/ParameterSet.h"
+#include "morea_core/InitialPopulation.h"
+#include "morea_core/ParameterSet.h"
 
 #include <gtest/gtest.h>
 
@@ -14,7 +14,7 @@
 
 namespace
 {
-using morea::Vec3;
+using morea_core::Vec3;
 
 double
 LargestMove(const std::vector<Vec3> & a, const std::vector<Vec3> & b)
@@ -29,10 +29,10 @@ LargestMove(const std::vector<Vec3> & a, const std::vector<Vec3> & b)
 TEST(InitialPopulation, HundredSolutionsAreFoldFreeAndDistinct)
 {
   const auto &              pm = morea_test::PhantomMesh600();
-  const morea::MeshTopology topology(pm.mesh.tetrahedra, pm.mesh.NumberOfPoints());
-  morea::FoldConstraint     constraint(topology, pm.mesh.points);
+  const morea_core::MeshTopology topology(pm.mesh.tetrahedra, pm.mesh.NumberOfPoints());
+  morea_core::FoldConstraint     constraint(topology, pm.mesh.points);
   const auto                start = std::chrono::steady_clock::now();
-  const auto                population = morea::GenerateInitialPopulation(pm.mesh, constraint, 100, 3);
+  const auto                population = morea_core::GenerateInitialPopulation(pm.mesh, constraint, 100, 3);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   ASSERT_EQ(population.size(), 100u);
   EXPECT_EQ(population[0].source, pm.mesh.points);
@@ -48,8 +48,8 @@ TEST(InitialPopulation, HundredSolutionsAreFoldFreeAndDistinct)
     EXPECT_TRUE(constraint.Evaluate(s.target).Feasible()) << "solution " << i;
     for (std::size_t p = 0; p < s.source.size(); ++p)
     {
-      ASSERT_EQ(morea::ProjectToDomain(s.source[p], pm.mesh.pins[p], pm.domain), s.source[p]);
-      ASSERT_EQ(morea::ProjectToDomain(s.target[p], pm.mesh.pins[p], pm.domain), s.target[p]);
+      ASSERT_EQ(morea_core::ProjectToDomain(s.source[p], pm.mesh.pins[p], pm.domain), s.source[p]);
+      ASSERT_EQ(morea_core::ProjectToDomain(s.target[p], pm.mesh.pins[p], pm.domain), s.target[p]);
     }
     if (i == 0)
       continue;
@@ -65,22 +65,22 @@ TEST(InitialPopulation, HundredSolutionsAreFoldFreeAndDistinct)
             << " mm (domain's smallest extent " << minExtent << " mm)\n";
 
   // Reproducible from the seed; another seed gives other solutions.
-  const auto again = morea::GenerateInitialPopulation(pm.mesh, constraint, 5, 3);
+  const auto again = morea_core::GenerateInitialPopulation(pm.mesh, constraint, 5, 3);
   for (std::size_t i = 0; i < 5; ++i)
     EXPECT_EQ(again[i].target, population[i].target);
-  EXPECT_NE(morea::GenerateInitialPopulation(pm.mesh, constraint, 2, 4)[1].target, population[1].target);
+  EXPECT_NE(morea_core::GenerateInitialPopulation(pm.mesh, constraint, 2, 4)[1].target, population[1].target);
 }
 
 TEST(InitialPopulation, NoNoiseGivesCopiesOfTheBase)
 {
   const auto &              pm = morea_test::PhantomMesh600();
-  const morea::MeshTopology topology(pm.mesh.tetrahedra, pm.mesh.NumberOfPoints());
-  morea::FoldConstraint     constraint(topology, pm.mesh.points);
-  morea::ParameterSet       p;
+  const morea_core::MeshTopology topology(pm.mesh.tetrahedra, pm.mesh.NumberOfPoints());
+  morea_core::FoldConstraint     constraint(topology, pm.mesh.points);
+  morea_core::ParameterSet       p;
   p.SetFromString("morea_init_noise_method", "none");
-  const auto options = morea::InitialPopulationOptions::FromParameters(p);
+  const auto options = morea_core::InitialPopulationOptions::FromParameters(p);
   EXPECT_EQ(options.noiseFactor, 0.0);
-  for (const auto & s : morea::GenerateInitialPopulation(pm.mesh, constraint, 4, 1, options))
+  for (const auto & s : morea_core::GenerateInitialPopulation(pm.mesh, constraint, 4, 1, options))
     EXPECT_EQ(s.source, pm.mesh.points);
 }
 } // namespace

@@ -3,9 +3,9 @@
 // Tests of the deformation magnitude objective.
 #include "MeshTestSupport.h"
 
-#include "morea/Error.h"
-#include "morea/InitialPopulation.h"
-#include "morea/MagnitudeObjective.h"
+#include "morea_core/Error.h"
+#include "morea_core/InitialPopulation.h"
+#include "morea_core/MagnitudeObjective.h"
 
 #include <gtest/gtest.h>
 
@@ -13,7 +13,7 @@
 
 namespace
 {
-using morea::Vec3;
+using morea_core::Vec3;
 
 TEST(MagnitudeObjective, ScalingAUnitTetrahedronByTwo)
 {
@@ -23,31 +23,31 @@ TEST(MagnitudeObjective, ScalingAUnitTetrahedronByTwo)
   std::vector<Vec3>               target;
   for (const Vec3 & p : source)
     target.push_back({ { 2 * p[0] + 5, 2 * p[1], 2 * p[2] - 1 } });
-  const morea::MeshTopology topology({ { { 0, 1, 2, 3 } } }, 4);
-  EXPECT_NEAR(morea::TetrahedronMagnitude(topology.Tetrahedra()[0], source, target, 2.0), 22.5, 1e-12);
-  EXPECT_NEAR(morea::MagnitudeObjective(topology, { source, target }, { 2.0 }), 2.25, 1e-12);
-  EXPECT_THROW(morea::MagnitudeObjective(topology, { source, target }, { 1.0, 2.0 }), morea::Error);
+  const morea_core::MeshTopology topology({ { { 0, 1, 2, 3 } } }, 4);
+  EXPECT_NEAR(morea_core::TetrahedronMagnitude(topology.Tetrahedra()[0], source, target, 2.0), 22.5, 1e-12);
+  EXPECT_NEAR(morea_core::MagnitudeObjective(topology, { source, target }, { 2.0 }), 2.25, 1e-12);
+  EXPECT_THROW(morea_core::MagnitudeObjective(topology, { source, target }, { 1.0, 2.0 }), morea_core::Error);
 }
 
 TEST(MagnitudeObjective, RigidMotionsCostNothingAndPartsSumToTheWhole)
 {
   const auto &              pm = morea_test::PhantomMesh600();
-  const morea::MeshTopology topology(pm.mesh.tetrahedra, pm.mesh.NumberOfPoints());
-  morea::DualMesh           moved = morea::DualMesh::FromBase(pm.mesh);
+  const morea_core::MeshTopology topology(pm.mesh.tetrahedra, pm.mesh.NumberOfPoints());
+  morea_core::DualMesh           moved = morea_core::DualMesh::FromBase(pm.mesh);
   const double              c = std::cos(0.3), s = std::sin(0.3);
   for (auto & p : moved.target)
     p = { { c * p[0] - s * p[1] + 7.0, s * p[0] + c * p[1] - 2.0, p[2] + 1.0 } };
-  EXPECT_NEAR(morea::MagnitudeObjective(topology, moved, {}), 0.0, 1e-20);
+  EXPECT_NEAR(morea_core::MagnitudeObjective(topology, moved, {}), 0.0, 1e-20);
 
-  const morea::FoldConstraint constraint(topology, pm.mesh.points);
-  const auto                  population = morea::GenerateInitialPopulation(pm.mesh, constraint, 3, 5);
+  const morea_core::FoldConstraint constraint(topology, pm.mesh.points);
+  const auto                  population = morea_core::GenerateInitialPopulation(pm.mesh, constraint, 3, 5);
   std::vector<double>         elasticity(topology.NumberOfTetrahedra());
   for (std::size_t t = 0; t < elasticity.size(); ++t)
     elasticity[t] = 0.5 + static_cast<double>(t % 7);
-  const double whole = morea::MagnitudeObjective(topology, population[2], elasticity);
+  const double whole = morea_core::MagnitudeObjective(topology, population[2], elasticity);
   double       parts = 0.0;
   for (std::size_t t = 0; t < topology.NumberOfTetrahedra(); ++t)
-    parts += morea::TetrahedronMagnitude(topology.Tetrahedra()[t], population[2].source, population[2].target,
+    parts += morea_core::TetrahedronMagnitude(topology.Tetrahedra()[t], population[2].source, population[2].target,
                                          elasticity[t]) /
              (10.0 * static_cast<double>(topology.NumberOfTetrahedra()));
   EXPECT_GT(whole, 0.0);

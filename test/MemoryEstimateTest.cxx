@@ -5,9 +5,9 @@
 // ea_population_size, and the paper's configuration passes.
 #include "OptimiserTestProblem.h"
 
-#include "morea/Error.h"
-#include "morea/MemoryEstimate.h"
-#include "morea/ParameterSet.h"
+#include "morea_core/Error.h"
+#include "morea_core/MemoryEstimate.h"
+#include "morea_core/ParameterSet.h"
 
 #include <gtest/gtest.h>
 
@@ -15,7 +15,7 @@
 
 namespace
 {
-using namespace morea;
+using namespace morea_core;
 
 constexpr double GiB = 1024.0 * 1024.0 * 1024.0;
 

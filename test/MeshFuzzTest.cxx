@@ -6,7 +6,7 @@
 // random voxel sizes, point counts and shares (so each surface is decimated
 // to another level), with random sets of surfaces as constraints. Every case
 // must give a valid mesh (positive tetrahedra that tile the domain) or a
-// clear morea::Error, never a crash.
+// clear morea_core::Error, never a crash.
 //
 // CTest runs a fixed seed and MOREA_MESH_FUZZ_CASES cases (default 300);
 // MOREA_MESH_FUZZ_SEED picks other boxes, MOREA_MESH_FUZZ_ONLY=N meshes case
@@ -16,12 +16,12 @@
 #include "itkMeshModel.h"
 #include "itkPreprocessing.h"
 #include "itkRegistrationProblem.h"
-#include "morea/ParameterSet.h"
-#include "morea/Error.h"
-#include "morea/MeshGenerator.h"
-#include "morea/MeshPointPlacement.h"
-#include "morea/Phantom.h"
-#include "morea/Random.h"
+#include "morea_core/ParameterSet.h"
+#include "morea_core/Error.h"
+#include "morea_core/MeshGenerator.h"
+#include "morea_core/MeshPointPlacement.h"
+#include "morea_core/Phantom.h"
+#include "morea_core/Random.h"
 
 #include <gtest/gtest.h>
 
@@ -37,8 +37,8 @@
 
 namespace
 {
-using morea::Vec3;
-using Mask = morea::Volume<std::uint8_t>;
+using morea_core::Vec3;
+using Mask = morea_core::Volume<std::uint8_t>;
 
 /** Masks on one grid, and where each one's boundary lies (crop centres). */
 struct Source
@@ -71,7 +71,7 @@ AddBoundaries(Source & source)
 {
   for (const auto & [name, mask] : source.masks)
   {
-    std::vector<Vec3> all = morea::MaskBoundaryPoints(mask);
+    std::vector<Vec3> all = morea_core::MaskBoundaryPoints(mask);
     std::vector<Vec3> some;
     for (std::size_t i = 0; i < all.size(); i += std::max<std::size_t>(1, all.size() / 2000))
       some.push_back(all[i]);
@@ -98,11 +98,11 @@ LoadSources()
     sources.push_back(std::move(lung));
   }
   sources.push_back(std::move(abdomen));
-  morea::PhantomOptions po;
+  morea_core::PhantomOptions po;
   po.spacing = 2.0;
-  auto   phantom = morea::PelvisPhantom(po).Generate();
+  auto   phantom = morea_core::PelvisPhantom(po).Generate();
   Source p{ "phantom", {}, {} };
-  const auto & names = morea::PelvisPhantom::StructureNames();
+  const auto & names = morea_core::PelvisPhantom::StructureNames();
   for (std::size_t s = 0; s < names.size(); ++s)
     if (names[s] != "body")
       p.masks.emplace_back(names[s], std::move(phantom.movingMasks[s]));
@@ -147,7 +147,7 @@ Crop(const Mask & mask, const Vec3 & lower, const Vec3 & upper, double spacing)
 
 /** Empty when the mesh is valid, else what is wrong with it. */
 std::string
-MeshProblem(const morea::TetrahedralMesh & mesh, const morea::MeshDomain & domain)
+MeshProblem(const morea_core::TetrahedralMesh & mesh, const morea_core::MeshDomain & domain)
 {
   const Vec3   e = domain.Extent();
   const double box = e[0] * e[1] * e[2];
@@ -157,7 +157,7 @@ MeshProblem(const morea::TetrahedralMesh & mesh, const morea::MeshDomain & domai
     for (std::uint32_t v : t)
       if (v >= mesh.NumberOfPoints())
         return "a tetrahedron refers to a missing point";
-    const double v = morea::SignedVolume(t, mesh.points);
+    const double v = morea_core::SignedVolume(t, mesh.points);
     if (!(v > 0.0))
       return "a tetrahedron of volume " + std::to_string(v);
     volume += v;
@@ -205,7 +205,7 @@ TEST(MeshFuzz, RandomCropsOfRealMasksGiveValidMeshesOrClearErrors)
     std::cout << " " << s.name << " (" << s.masks.size() << " masks)";
   std::cout << "; loaded in " << loadSeconds << " s\n";
 
-  morea::RandomGenerator             random(seed);
+  morea_core::RandomGenerator             random(seed);
   const auto                         pick = [&random](std::size_t n) { return static_cast<std::size_t>(random.NextU64() % n); };
   std::size_t                        meshes = 0, errors = 0, invalid = 0, allSurfaces = 0, someSurfacesLost = 0;
   std::size_t                        surfacesAsked = 0, surfacesUsed = 0;
@@ -254,11 +254,11 @@ TEST(MeshFuzz, RandomCropsOfRealMasksGiveValidMeshesOrClearErrors)
       --perSource[source.name];
       continue;
     }
-    const morea::MeshDomain           domain = morea::MeshDomain::OfGrid(masks.front());
-    std::vector<morea::MeshStructure> structures;
+    const morea_core::MeshDomain           domain = morea_core::MeshDomain::OfGrid(masks.front());
+    std::vector<morea_core::MeshStructure> structures;
     for (std::size_t s = 0; s < masks.size(); ++s)
-      structures.push_back({ names[s], morea::MaskBoundaryPoints(masks[s]), &masks[s] });
-    morea::MeshGeneratorOptions options;
+      structures.push_back({ names[s], morea_core::MaskBoundaryPoints(masks[s]), &masks[s] });
+    morea_core::MeshGeneratorOptions options;
     options.numberOfPoints = 60 + pick(641);
     options.seed = seed + c;
     options.tetrahedralization.isolated = std::getenv("MOREA_MESH_FUZZ_IN_PROCESS") == nullptr;
@@ -286,8 +286,8 @@ TEST(MeshFuzz, RandomCropsOfRealMasksGiveValidMeshesOrClearErrors)
     const auto caseStart = std::chrono::steady_clock::now();
     try
     {
-      morea::MeshGenerationReport report;
-      const morea::TetrahedralMesh mesh = morea::GenerateMesh(domain, structures, options, &report);
+      morea_core::MeshGenerationReport report;
+      const morea_core::TetrahedralMesh mesh = morea_core::GenerateMesh(domain, structures, options, &report);
       if (c == only)
         std::cout << what << ": " << mesh.NumberOfPoints() << " points (" << report.steinerPoints << " Steiner), "
                   << mesh.NumberOfTetrahedra() << " tetrahedra, " << report.surfaceTriangles
@@ -319,7 +319,7 @@ TEST(MeshFuzz, RandomCropsOfRealMasksGiveValidMeshesOrClearErrors)
       surfacesUsed += options.surfaceStructures.size() - lost.size();
       (lost.empty() ? allSurfaces : someSurfacesLost) += 1;
     }
-    catch (const morea::Error & e)
+    catch (const morea_core::Error & e)
     {
       ++errors;
       ++errorKinds[std::string(e.what()).substr(0, 60)];
@@ -327,7 +327,7 @@ TEST(MeshFuzz, RandomCropsOfRealMasksGiveValidMeshesOrClearErrors)
     }
     catch (const std::exception & e)
     {
-      ADD_FAILURE() << what << ": not a morea::Error: " << e.what();
+      ADD_FAILURE() << what << ": not a morea_core::Error: " << e.what();
     }
     const double caseSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - caseStart).count();
     if (caseSeconds > slowest)
@@ -371,7 +371,7 @@ TEST(MeshFuzz, TheAbdomenCropThatCrashedTetGenGivesAMesh)
     problem.LoadStructure(organ, true, (dir / "CB02_masks" / (std::string(organ) + ".mha")).string());
     problem.LoadStructure(organ, false, (dir / "CB07_masks" / (std::string(organ) + ".mha")).string());
   }
-  morea::ParameterSet parameters;
+  morea_core::ParameterSet parameters;
   for (const auto & [key, value] : std::vector<std::pair<std::string, std::string>>{
          { "preprocess_isotropic_spacing", "3.0" },
          { "preprocess_rigid_structure", "none" },

@@ -4,9 +4,9 @@
 // rasterised in both directions compose to the identity.
 #include "MeshTestSupport.h"
 
-#include "morea/FoldConstraint.h"
-#include "morea/InitialPopulation.h"
-#include "morea/MeshRasterizer.h"
+#include "morea_core/FoldConstraint.h"
+#include "morea_core/InitialPopulation.h"
+#include "morea_core/MeshRasterizer.h"
 
 #include <gtest/gtest.h>
 
@@ -16,11 +16,11 @@
 
 namespace
 {
-using morea::Vec3;
+using morea_core::Vec3;
 
 /** Trilinear interpolation of a displacement volume (clamped at the border). */
 Vec3
-Interpolate(const morea::Volume<Vec3> & field, const Vec3 & p)
+Interpolate(const morea_core::Volume<Vec3> & field, const Vec3 & p)
 {
   double      t[3];
   std::size_t i0[3], i1[3];
@@ -46,9 +46,9 @@ Interpolate(const morea::Volume<Vec3> & field, const Vec3 & p)
 TEST(MeshModel, BothDirectionsOfRandomSolutionsComposeToIdentity)
 {
   const auto &              pm = morea_test::PhantomMesh600();
-  const morea::MeshTopology topology(pm.mesh.tetrahedra, pm.mesh.NumberOfPoints());
-  morea::FoldConstraint     constraint(topology, pm.mesh.points);
-  const auto                population = morea::GenerateInitialPopulation(pm.mesh, constraint, 9, 11);
+  const morea_core::MeshTopology topology(pm.mesh.tetrahedra, pm.mesh.NumberOfPoints());
+  morea_core::FoldConstraint     constraint(topology, pm.mesh.points);
+  const auto                population = morea_core::GenerateInitialPopulation(pm.mesh, constraint, 9, 11);
 
   const double               h = 3.0; // the phantom's voxel size
   std::array<std::size_t, 3> size{};
@@ -57,12 +57,12 @@ TEST(MeshModel, BothDirectionsOfRandomSolutionsComposeToIdentity)
     size[a] = static_cast<std::size_t>(std::lround(e[a] / h)) + 1;
   for (std::size_t s = 1; s < population.size(); ++s)
   {
-    morea::Volume<Vec3> fixedToMoving(size, { { h, h, h } }, pm.domain.lower);
-    morea::Volume<Vec3> movingToFixed = fixedToMoving;
-    morea::RasterizationReport forward, backward;
+    morea_core::Volume<Vec3> fixedToMoving(size, { { h, h, h } }, pm.domain.lower);
+    morea_core::Volume<Vec3> movingToFixed = fixedToMoving;
+    morea_core::RasterizationReport forward, backward;
     const auto start = std::chrono::steady_clock::now();
-    morea::RasterizeDisplacement(topology, population[s].target, population[s].source, fixedToMoving, &forward);
-    morea::RasterizeDisplacement(topology, population[s].source, population[s].target, movingToFixed, &backward);
+    morea_core::RasterizeDisplacement(topology, population[s].target, population[s].source, fixedToMoving, &forward);
+    morea_core::RasterizeDisplacement(topology, population[s].source, population[s].target, movingToFixed, &backward);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     EXPECT_EQ(forward.outsideMesh, 0u);
     EXPECT_EQ(backward.outsideMesh, 0u);

@@ -1,8 +1,8 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/MeshRasterizer.h"
+#include "morea_core/MeshRasterizer.h"
 
-#include "morea/Error.h"
+#include "morea_core/Error.h"
 
 #include "BoxMesh.h"
 
@@ -14,8 +14,8 @@
 
 namespace
 {
-using morea::Vec3;
-using morea::Volume;
+using morea_core::Vec3;
+using morea_core::Volume;
 using Mat3 = std::array<Vec3, 3>; // rows
 
 /** A non-trivial affine map x -> A x + b with det A > 0. */
@@ -116,8 +116,8 @@ class MeshRasterizer : public ::testing::Test
 {
 protected:
   Volume<Vec3>        grid = TestGrid();
-  morea_test::BoxMesh box = morea_test::MakeBoxMesh(morea::MeshDomain::OfGrid(grid), { 5, 4, 4 });
-  morea::MeshTopology topology{ box.tetrahedra, box.points.size() };
+  morea_test::BoxMesh box = morea_test::MakeBoxMesh(morea_core::MeshDomain::OfGrid(grid), { 5, 4, 4 });
+  morea_core::MeshTopology topology{ box.tetrahedra, box.points.size() };
 };
 } // namespace
 
@@ -129,8 +129,8 @@ TEST_F(MeshRasterizer, BoxMeshIsValid)
 
 TEST_F(MeshRasterizer, IdenticalMeshesGiveZeroField)
 {
-  morea::RasterizationReport report;
-  morea::RasterizeDisplacement(topology, box.points, box.points, grid, &report);
+  morea_core::RasterizationReport report;
+  morea_core::RasterizeDisplacement(topology, box.points, box.points, grid, &report);
   EXPECT_EQ(report.voxels, grid.NumberOfVoxels());
   EXPECT_EQ(report.outsideMesh, 0u);
   double largest = 0.0;
@@ -141,8 +141,8 @@ TEST_F(MeshRasterizer, IdenticalMeshesGiveZeroField)
 
 TEST_F(MeshRasterizer, AffineTargetReproducesAffineMap)
 {
-  morea::RasterizationReport report;
-  morea::RasterizeDisplacement(topology, box.points, MapPoints(box.points, AffineImage), grid, &report);
+  morea_core::RasterizationReport report;
+  morea_core::RasterizeDisplacement(topology, box.points, MapPoints(box.points, AffineImage), grid, &report);
   EXPECT_EQ(report.outsideMesh, 0u);
   double worst = 0.0;
   for (std::size_t k = 0; k < grid.size[2]; ++k)
@@ -157,8 +157,8 @@ TEST_F(MeshRasterizer, AffineTargetReproducesAffineMap)
 
 TEST_F(MeshRasterizer, AffineSourceGivesInverseMapInsideItsImage)
 {
-  morea::RasterizationReport report;
-  morea::RasterizeDisplacement(topology, MapPoints(box.points, AffineImage), box.points, grid, &report);
+  morea_core::RasterizationReport report;
+  morea_core::RasterizeDisplacement(topology, MapPoints(box.points, AffineImage), box.points, grid, &report);
   // The sheared, shifted box leaves part of the grid uncovered.
   EXPECT_GT(report.outsideMesh, 0u);
   EXPECT_LT(report.outsideMesh, grid.NumberOfVoxels());
@@ -189,16 +189,16 @@ TEST(MeshRasterizerInverse, RandomPerturbationComposesToIdentity)
   // gentle relative to the cells (~9 voxels wide), yet moves voxels by more than
   // a voxel; a wrong tetrahedron or map would cost about the displacement itself.
   const Volume<Vec3>        grid({ 56, 52, 48 }, { 1.0, 1.1, 0.9 }, { -12.0, 5.0, 30.0 });
-  const auto                box = morea_test::MakeBoxMesh(morea::MeshDomain::OfGrid(grid), { 3, 3, 3 });
-  const morea::MeshTopology topology(box.tetrahedra, box.points.size());
+  const auto                box = morea_test::MakeBoxMesh(morea_core::MeshDomain::OfGrid(grid), { 3, 3, 3 });
+  const morea_core::MeshTopology topology(box.tetrahedra, box.points.size());
   const std::vector<Vec3>   moved = morea_test::Perturb(box, 0.06, 8);
   ASSERT_GT(morea_test::MinimumSignedVolume(box.tetrahedra, moved), 0.0) << "the perturbation folded the mesh";
   Volume<Vec3>               forward = grid;
   Volume<Vec3>               backward = grid;
-  morea::RasterizationReport forwardReport;
-  morea::RasterizationReport backwardReport;
-  morea::RasterizeDisplacement(topology, box.points, moved, forward, &forwardReport);
-  morea::RasterizeDisplacement(topology, moved, box.points, backward, &backwardReport);
+  morea_core::RasterizationReport forwardReport;
+  morea_core::RasterizationReport backwardReport;
+  morea_core::RasterizeDisplacement(topology, box.points, moved, forward, &forwardReport);
+  morea_core::RasterizeDisplacement(topology, moved, box.points, backward, &backwardReport);
   EXPECT_EQ(forwardReport.outsideMesh, 0u);
   EXPECT_EQ(backwardReport.outsideMesh, 0u);
 
@@ -223,20 +223,20 @@ TEST_F(MeshRasterizer, IsDeterministic)
   const std::vector<Vec3> moved = morea_test::Perturb(box, 0.2, 11);
   Volume<Vec3>            first = grid;
   Volume<Vec3>            second = grid;
-  morea::RasterizeDisplacement(topology, box.points, moved, first);
-  morea::RasterizeDisplacement(topology, box.points, moved, second);
+  morea_core::RasterizeDisplacement(topology, box.points, moved, first);
+  morea_core::RasterizeDisplacement(topology, box.points, moved, second);
   EXPECT_TRUE(first.data == second.data);
 }
 
 TEST_F(MeshRasterizer, PartialMeshExtrapolatesAffinely)
 {
   // A mesh over the voxel centres with i <= 19 only.
-  morea::MeshDomain half = box.domain;
+  morea_core::MeshDomain half = box.domain;
   half.upper[0] = grid.origin[0] + grid.spacing[0] * 19.0;
   const auto                 partial = morea_test::MakeBoxMesh(half, { 3, 4, 4 });
-  morea::MeshTopology        partialTopology(partial.tetrahedra, partial.points.size());
-  morea::RasterizationReport report;
-  morea::RasterizeDisplacement(partialTopology, partial.points, MapPoints(partial.points, AffineImage), grid, &report);
+  morea_core::MeshTopology        partialTopology(partial.tetrahedra, partial.points.size());
+  morea_core::RasterizationReport report;
+  morea_core::RasterizeDisplacement(partialTopology, partial.points, MapPoints(partial.points, AffineImage), grid, &report);
   EXPECT_EQ(report.outsideMesh, (grid.size[0] - 20) * grid.size[1] * grid.size[2]);
   double worst = 0.0;
   for (std::size_t k = 0; k < grid.size[2]; ++k)
@@ -257,10 +257,10 @@ TEST_F(MeshRasterizer, DegenerateTetrahedraAreSkipped)
   // A zero-volume sliver (a repeated point) with the lowest index: were it not
   // skipped, its singular edge matrix would spread non-finite values.
   auto tetrahedra = box.tetrahedra;
-  tetrahedra.insert(tetrahedra.begin(), morea::Tetrahedron{ { 0, 1, 1, 2 } });
-  morea::MeshTopology        withSliver(tetrahedra, box.points.size());
-  morea::RasterizationReport report;
-  morea::RasterizeDisplacement(withSliver, box.points, MapPoints(box.points, AffineImage), grid, &report);
+  tetrahedra.insert(tetrahedra.begin(), morea_core::Tetrahedron{ { 0, 1, 1, 2 } });
+  morea_core::MeshTopology        withSliver(tetrahedra, box.points.size());
+  morea_core::RasterizationReport report;
+  morea_core::RasterizeDisplacement(withSliver, box.points, MapPoints(box.points, AffineImage), grid, &report);
   EXPECT_EQ(report.outsideMesh, 0u);
   double worst = 0.0;
   for (std::size_t k = 0; k < grid.size[2]; ++k)
@@ -277,13 +277,13 @@ TEST_F(MeshRasterizer, DegenerateTetrahedraAreSkipped)
 TEST_F(MeshRasterizer, BadInputsThrow)
 {
   std::vector<Vec3> tooFew(box.points.begin(), box.points.end() - 1);
-  EXPECT_THROW(morea::RasterizeDisplacement(topology, tooFew, box.points, grid), morea::Error);
+  EXPECT_THROW(morea_core::RasterizeDisplacement(topology, tooFew, box.points, grid), morea_core::Error);
   Volume<Vec3> flat = grid;
   flat.spacing[1] = 0.0;
-  EXPECT_THROW(morea::RasterizeDisplacement(topology, box.points, box.points, flat), morea::Error);
+  EXPECT_THROW(morea_core::RasterizeDisplacement(topology, box.points, box.points, flat), morea_core::Error);
   // A mesh far away from the grid leaves nothing to extrapolate from.
   auto far = box.points;
   for (auto & p : far)
     p[0] += 1000.0;
-  EXPECT_THROW(morea::RasterizeDisplacement(topology, far, far, grid), morea::Error);
+  EXPECT_THROW(morea_core::RasterizeDisplacement(topology, far, far, grid), morea_core::Error);
 }

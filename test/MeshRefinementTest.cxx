@@ -4,10 +4,10 @@
 // carry-over of solutions, objective values kept, and the level plan.
 #include "OptimiserTestProblem.h"
 
-#include "morea/EvaluationBackend.h"
-#include "morea/Error.h"
-#include "morea/MeshRefinement.h"
-#include "morea/ParameterSet.h"
+#include "morea_core/EvaluationBackend.h"
+#include "morea_core/Error.h"
+#include "morea_core/MeshRefinement.h"
+#include "morea_core/ParameterSet.h"
 
 #include <gtest/gtest.h>
 
@@ -23,7 +23,7 @@ using morea_test::OptimiserTestProblem;
 /** Every triangle of a conforming mesh is shared by at most two
  *  tetrahedra, and the boundary triangles cover exactly the box's six faces. */
 void
-ExpectConforming(const morea::TetrahedralMesh & mesh)
+ExpectConforming(const morea_core::TetrahedralMesh & mesh)
 {
   std::map<std::array<std::uint32_t, 3>, int> faces;
   for (const auto & t : mesh.tetrahedra)
@@ -46,21 +46,21 @@ ExpectConforming(const morea::TetrahedralMesh & mesh)
       const auto & a = mesh.points[f[0]];
       const auto & b = mesh.points[f[1]];
       const auto & c = mesh.points[f[2]];
-      const morea::Vec3 u{ b[0] - a[0], b[1] - a[1], b[2] - a[2] }, v{ c[0] - a[0], c[1] - a[1], c[2] - a[2] };
-      const morea::Vec3 n{ u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0] };
+      const morea_core::Vec3 u{ b[0] - a[0], b[1] - a[1], b[2] - a[2] }, v{ c[0] - a[0], c[1] - a[1], c[2] - a[2] };
+      const morea_core::Vec3 n{ u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0] };
       boundaryArea += 0.5 * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     }
   }
-  const morea::Vec3 e = mesh.domain.Extent();
+  const morea_core::Vec3 e = mesh.domain.Extent();
   EXPECT_NEAR(boundaryArea, 2.0 * (e[0] * e[1] + e[1] * e[2] + e[0] * e[2]), 1e-6); // no hanging node leaves a hole
 }
 
 double
-TotalVolume(const morea::TetrahedralMesh & mesh)
+TotalVolume(const morea_core::TetrahedralMesh & mesh)
 {
   double v = 0.0;
   for (const auto & t : mesh.tetrahedra)
-    v += morea::SignedVolume(t, mesh.points);
+    v += morea_core::SignedVolume(t, mesh.points);
   return v;
 }
 
@@ -68,17 +68,17 @@ TEST(MeshRefinement, BisectsToTheTargetConformingAndPositive)
 {
   const OptimiserTestProblem problem;
   const std::vector<double>  uniform(problem.base.NumberOfTetrahedra(), 1.0);
-  const auto                 refinement = morea::RefineMesh(problem.base, uniform, 3 * problem.base.NumberOfPoints());
+  const auto                 refinement = morea_core::RefineMesh(problem.base, uniform, 3 * problem.base.NumberOfPoints());
   const auto &               mesh = refinement.mesh;
   EXPECT_EQ(mesh.NumberOfPoints(), 3 * problem.base.NumberOfPoints());
   EXPECT_EQ(refinement.midpointOf.size(), 2 * problem.base.NumberOfPoints());
   EXPECT_EQ(refinement.parentTetrahedron.size(), mesh.NumberOfTetrahedra());
   EXPECT_EQ(mesh.pins.size(), mesh.NumberOfPoints());
-  EXPECT_EQ(mesh.origins.back(), morea::PointOrigin::Midpoint);
+  EXPECT_EQ(mesh.origins.back(), morea_core::PointOrigin::Midpoint);
   for (std::size_t p = 0; p < problem.base.NumberOfPoints(); ++p)
     EXPECT_EQ(mesh.points[p], problem.base.points[p]); // the coarse points keep their indices
   for (const auto & t : mesh.tetrahedra)
-    EXPECT_GT(morea::SignedVolume(t, mesh.points), 0.0);
+    EXPECT_GT(morea_core::SignedVolume(t, mesh.points), 0.0);
   EXPECT_NEAR(TotalVolume(mesh), TotalVolume(problem.base), 1e-9);
   ExpectConforming(mesh);
   // Pins: a midpoint lies on a face only when its pin says so, and then exactly.
@@ -93,10 +93,10 @@ TEST(MeshRefinement, BisectsToTheTargetConformingAndPositive)
   // Longest-edge bisection keeps shapes: no tetrahedron much worse than the coarse mesh's worst.
   double coarseWorst = 1.0, fineWorst = 1.0;
   for (const auto & t : problem.base.tetrahedra)
-    coarseWorst = std::min(coarseWorst, morea::TetrahedronQuality(problem.base.points[t[0]], problem.base.points[t[1]],
+    coarseWorst = std::min(coarseWorst, morea_core::TetrahedronQuality(problem.base.points[t[0]], problem.base.points[t[1]],
                                                                   problem.base.points[t[2]], problem.base.points[t[3]]));
   for (const auto & t : mesh.tetrahedra)
-    fineWorst = std::min(fineWorst, morea::TetrahedronQuality(mesh.points[t[0]], mesh.points[t[1]], mesh.points[t[2]],
+    fineWorst = std::min(fineWorst, morea_core::TetrahedronQuality(mesh.points[t[0]], mesh.points[t[1]], mesh.points[t[2]],
                                                               mesh.points[t[3]]));
   EXPECT_GT(fineWorst, 0.3 * coarseWorst);
 }
@@ -113,14 +113,14 @@ TEST(MeshRefinement, PointsGoWhereTheDensityIsHigh)
       x += 0.25 * problem.base.points[p][0];
     density[t] = x < 15.0 ? 10.0 : 1.0;
   }
-  const auto  refinement = morea::RefineMesh(problem.base, density, 2 * problem.base.NumberOfPoints());
+  const auto  refinement = morea_core::RefineMesh(problem.base, density, 2 * problem.base.NumberOfPoints());
   std::size_t low = 0, high = 0;
   for (std::size_t p = problem.base.NumberOfPoints(); p < refinement.mesh.NumberOfPoints(); ++p)
     (refinement.mesh.points[p][0] < 15.0 ? low : high) += 1;
   EXPECT_GT(low, 2 * high);
-  EXPECT_THROW(morea::RefineMesh(problem.base, std::vector<double>(3, 1.0), 200), morea::Error);
+  EXPECT_THROW(morea_core::RefineMesh(problem.base, std::vector<double>(3, 1.0), 200), morea_core::Error);
   density[0] = 0.0;
-  EXPECT_THROW(morea::RefineMesh(problem.base, density, 200), morea::Error);
+  EXPECT_THROW(morea_core::RefineMesh(problem.base, density, 200), morea_core::Error);
 }
 
 TEST(MeshRefinement, CarriedSolutionsKeepTheirDeformationFoldsAndObjectives)
@@ -130,17 +130,17 @@ TEST(MeshRefinement, CarriedSolutionsKeepTheirDeformationFoldsAndObjectives)
   const auto            options = problem.Options(11);
   const auto            population = problem.InitialPopulation(options);
   const std::vector<double> uniform(problem.base.NumberOfTetrahedra(), 1.0);
-  const auto            refinement = morea::RefineMesh(problem.base, uniform, 4 * problem.base.NumberOfPoints());
+  const auto            refinement = morea_core::RefineMesh(problem.base, uniform, 4 * problem.base.NumberOfPoints());
 
   // The fine model, as a level's would be.
-  const morea::MeshTopology       topology(refinement.mesh.tetrahedra, refinement.mesh.NumberOfPoints());
-  const morea::FoldConstraint     constraint(topology, refinement.mesh.points);
+  const morea_core::MeshTopology       topology(refinement.mesh.tetrahedra, refinement.mesh.NumberOfPoints());
+  const morea_core::FoldConstraint     constraint(topology, refinement.mesh.points);
   const std::vector<double>       elasticity(topology.NumberOfTetrahedra(), 1.0);
-  const morea::TetrahedronEvaluator fine(topology, constraint, elasticity, problem.data);
-  const morea::TetrahedronEvaluator & coarse = *problem.evaluator;
+  const morea_core::TetrahedronEvaluator fine(topology, constraint, elasticity, problem.data);
+  const morea_core::TetrahedronEvaluator & coarse = *problem.evaluator;
 
-  auto totals = [](const morea::TetrahedronEvaluator & evaluator, const morea::DualMesh & solution) {
-    morea::ObjectiveTotals sum;
+  auto totals = [](const morea_core::TetrahedronEvaluator & evaluator, const morea_core::DualMesh & solution) {
+    morea_core::ObjectiveTotals sum;
     for (std::size_t t = 0; t < evaluator.Topology().NumberOfTetrahedra(); ++t)
       sum.Add(evaluator.Evaluate(t, solution));
     return sum;
@@ -148,7 +148,7 @@ TEST(MeshRefinement, CarriedSolutionsKeepTheirDeformationFoldsAndObjectives)
   std::size_t compared = 0;
   for (const auto & solution : population)
   {
-    const morea::DualMesh carried = morea::CarryOver(refinement, solution);
+    const morea_core::DualMesh carried = morea_core::CarryOver(refinement, solution);
     ASSERT_EQ(carried.source.size(), refinement.mesh.NumberOfPoints());
     // The same map: each fine point's target is the coarse map of its source.
     for (std::size_t f = 0; f < topology.NumberOfTetrahedra(); ++f)
@@ -156,8 +156,8 @@ TEST(MeshRefinement, CarriedSolutionsKeepTheirDeformationFoldsAndObjectives)
       const auto & child = topology.Tetrahedra()[f];
       const auto & parent = problem.base.tetrahedra[refinement.parentTetrahedron[f]];
       // Source and target volume ratios of child to parent agree (one affine map).
-      const double sourceRatio = morea::SignedVolume(child, carried.source) / morea::SignedVolume(parent, solution.source);
-      const double targetRatio = morea::SignedVolume(child, carried.target) / morea::SignedVolume(parent, solution.target);
+      const double sourceRatio = morea_core::SignedVolume(child, carried.source) / morea_core::SignedVolume(parent, solution.source);
+      const double targetRatio = morea_core::SignedVolume(child, carried.target) / morea_core::SignedVolume(parent, solution.target);
       ASSERT_NEAR(sourceRatio, targetRatio, 1e-9);
     }
     const bool coarseFeasible = problem.constraint->Evaluate(solution).Feasible();
@@ -177,7 +177,7 @@ TEST(MeshRefinement, CarriedSolutionsKeepTheirDeformationFoldsAndObjectives)
 TEST(MeshRefinement, DensityFollowsMismatch)
 {
   const OptimiserTestProblem                         problem;
-  std::vector<std::vector<morea::TetrahedronValues>> values(1, std::vector<morea::TetrahedronValues>(
+  std::vector<std::vector<morea_core::TetrahedronValues>> values(1, std::vector<morea_core::TetrahedronValues>(
                                                                   problem.base.NumberOfTetrahedra()));
   for (auto & v : values[0])
   {
@@ -185,7 +185,7 @@ TEST(MeshRefinement, DensityFollowsMismatch)
     v.intensity = 1.0;
   }
   values[0][5].intensity = 50.0;
-  const auto density = morea::RefinementDensity(problem.base, values);
+  const auto density = morea_core::RefinementDensity(problem.base, values);
   ASSERT_EQ(density.size(), problem.base.NumberOfTetrahedra());
   EXPECT_GT(density[5], 2.0 * density[6]);
   for (double d : density)
@@ -194,22 +194,22 @@ TEST(MeshRefinement, DensityFollowsMismatch)
 
 TEST(MeshLevelPlan, SplitsTheGenerationsAndRefusesPlansWithoutRoom)
 {
-  auto plan = morea::MeshLevelPlan::FromParameters(morea::ParameterSet::FromToml(
+  auto plan = morea_core::MeshLevelPlan::FromParameters(morea_core::ParameterSet::FromToml(
     "ea_num_generations = 100\nmorea_max_num_mesh_levels = 3\nmorea_num_generations_per_level = 30\n"));
   EXPECT_EQ(plan.FirstGeneration(0), 0u);
   EXPECT_EQ(plan.EndGeneration(0), 30u);
   EXPECT_EQ(plan.FirstGeneration(2), 60u);
   EXPECT_EQ(plan.EndGeneration(2), 100u);
   EXPECT_EQ(plan.PointsAt(2, 600), 3174u);
-  EXPECT_EQ(morea::MeshLevelPlan::FromParameters(morea::ParameterSet{}).levels, 1u);
-  EXPECT_THROW(morea::MeshLevelPlan::FromParameters(morea::ParameterSet::FromToml(
+  EXPECT_EQ(morea_core::MeshLevelPlan::FromParameters(morea_core::ParameterSet{}).levels, 1u);
+  EXPECT_THROW(morea_core::MeshLevelPlan::FromParameters(morea_core::ParameterSet::FromToml(
                  "ea_num_generations = 60\nmorea_max_num_mesh_levels = 3\nmorea_num_generations_per_level = 30\n")),
-               morea::Error);
-  EXPECT_THROW(morea::MeshLevelPlan::FromParameters(morea::ParameterSet::FromToml("morea_max_num_mesh_levels = 2\n")),
-               morea::Error);
+               morea_core::Error);
+  EXPECT_THROW(morea_core::MeshLevelPlan::FromParameters(morea_core::ParameterSet::FromToml("morea_max_num_mesh_levels = 2\n")),
+               morea_core::Error);
   EXPECT_THROW(
-    morea::MeshLevelPlan::FromParameters(morea::ParameterSet::FromToml("morea_num_generations_per_level = 20\n")),
-    morea::Error);
+    morea_core::MeshLevelPlan::FromParameters(morea_core::ParameterSet::FromToml("morea_num_generations_per_level = 20\n")),
+    morea_core::Error);
 }
 
 TEST(MeshRefinement, AnOptimiserContinuesFromACarriedPopulation)
@@ -220,28 +220,28 @@ TEST(MeshRefinement, AnOptimiserContinuesFromACarriedPopulation)
   OptimiserTestProblem problem;
   auto                 options = problem.Options(3, 6);
   options.generations = 4;
-  auto coarseBackend = morea::CreateCpuEvaluationBackend(*problem.evaluator, 1);
-  morea::MoRvGomea coarse(problem.base, problem.topology, problem.parallel, *problem.constraint, *coarseBackend, options);
+  auto coarseBackend = morea_core::CreateCpuEvaluationBackend(*problem.evaluator, 1);
+  morea_core::MoRvGomea coarse(problem.base, problem.topology, problem.parallel, *problem.constraint, *coarseBackend, options);
   coarse.Initialize(problem.InitialPopulation(options));
   coarse.Run();
 
   const std::vector<double> uniform(problem.base.NumberOfTetrahedra(), 1.0);
-  const auto                refinement = morea::RefineMesh(problem.base, uniform, 2 * problem.base.NumberOfPoints());
-  const morea::MeshTopology topology(refinement.mesh.tetrahedra, refinement.mesh.NumberOfPoints());
-  const auto                parallel = morea::BuildParallelStructure(topology);
-  const morea::FoldConstraint constraint(topology, refinement.mesh.points);
+  const auto                refinement = morea_core::RefineMesh(problem.base, uniform, 2 * problem.base.NumberOfPoints());
+  const morea_core::MeshTopology topology(refinement.mesh.tetrahedra, refinement.mesh.NumberOfPoints());
+  const auto                parallel = morea_core::BuildParallelStructure(topology);
+  const morea_core::FoldConstraint constraint(topology, refinement.mesh.points);
   const std::vector<double>   elasticity(topology.NumberOfTetrahedra(), 1.0);
-  const morea::TetrahedronEvaluator evaluator(topology, constraint, elasticity, problem.data);
-  auto fineBackend = morea::CreateCpuEvaluationBackend(evaluator, 1);
+  const morea_core::TetrahedronEvaluator evaluator(topology, constraint, elasticity, problem.data);
+  auto fineBackend = morea_core::CreateCpuEvaluationBackend(evaluator, 1);
   auto fineOptions = options;
   fineOptions.firstGeneration = 4;
   fineOptions.generations = 6;
-  morea::MoRvGomea             fine(refinement.mesh, topology, parallel, constraint, *fineBackend, fineOptions);
-  std::vector<morea::DualMesh> population, archived;
+  morea_core::MoRvGomea             fine(refinement.mesh, topology, parallel, constraint, *fineBackend, fineOptions);
+  std::vector<morea_core::DualMesh> population, archived;
   for (const auto & s : coarse.Population())
-    population.push_back(morea::CarryOver(refinement, s));
+    population.push_back(morea_core::CarryOver(refinement, s));
   for (const auto & e : coarse.Archive().Entries())
-    archived.push_back(morea::CarryOver(refinement, e.solution));
+    archived.push_back(morea_core::CarryOver(refinement, e.solution));
   fine.Initialize(population, archived);
   EXPECT_EQ(fine.Generation(), 4u);
   EXPECT_GE(fine.Archive().Size(), 1u);
@@ -253,7 +253,7 @@ TEST(MeshRefinement, AnOptimiserContinuesFromACarriedPopulation)
     EXPECT_TRUE(constraint.Evaluate(e.solution).Feasible());
   // Its checkpoint loads into an optimiser of the same level only.
   const std::string bytes = fine.CheckpointBytes();
-  morea::MoRvGomea  again(refinement.mesh, topology, parallel, constraint, *fineBackend, fineOptions);
+  morea_core::MoRvGomea  again(refinement.mesh, topology, parallel, constraint, *fineBackend, fineOptions);
   std::istringstream in(bytes);
   EXPECT_NO_THROW(again.Load(in));
   EXPECT_EQ(again.Generation(), 6u);

@@ -4,9 +4,9 @@
 #ifndef MeshTestSupport_h
 #define MeshTestSupport_h
 
-#include "morea/MeshGenerator.h"
-#include "morea/MeshPointPlacement.h"
-#include "morea/Phantom.h"
+#include "morea_core/MeshGenerator.h"
+#include "morea_core/MeshPointPlacement.h"
+#include "morea_core/Phantom.h"
 
 #include <algorithm>
 #include <memory>
@@ -15,10 +15,10 @@ namespace morea_test
 {
 struct PhantomMesh
 {
-  morea::PelvisPhantom::Case    phantomCase;
-  morea::MeshDomain             domain;
-  morea::TetrahedralMesh        mesh;
-  morea::MeshGenerationReport   report;
+  morea_core::PelvisPhantom::Case    phantomCase;
+  morea_core::MeshDomain             domain;
+  morea_core::TetrahedralMesh        mesh;
+  morea_core::MeshGenerationReport   report;
   std::vector<std::string>      names;
 };
 
@@ -30,33 +30,33 @@ PhantomMesh600()
 {
   static const std::unique_ptr<PhantomMesh> cached = [] {
     auto                  pm = std::make_unique<PhantomMesh>();
-    morea::PhantomOptions po;
+    morea_core::PhantomOptions po;
     po.spacing = 3.0;
-    pm->phantomCase = morea::PelvisPhantom(po).Generate();
-    pm->names = morea::PelvisPhantom::StructureNames();
+    pm->phantomCase = morea_core::PelvisPhantom(po).Generate();
+    pm->names = morea_core::PelvisPhantom::StructureNames();
     const auto & bladder = pm->phantomCase.movingMasks[2];
-    morea::Vec3  lo{ { 1e9, 1e9, 1e9 } }, hi{ { -1e9, -1e9, -1e9 } };
-    for (const morea::Vec3 & p : morea::MaskBoundaryPoints(bladder))
+    morea_core::Vec3  lo{ { 1e9, 1e9, 1e9 } }, hi{ { -1e9, -1e9, -1e9 } };
+    for (const morea_core::Vec3 & p : morea_core::MaskBoundaryPoints(bladder))
       for (int a = 0; a < 3; ++a)
       {
         lo[a] = std::min(lo[a], p[a]);
         hi[a] = std::max(hi[a], p[a]);
       }
-    const morea::MeshDomain full = morea::MeshDomain::OfGrid(bladder);
+    const morea_core::MeshDomain full = morea_core::MeshDomain::OfGrid(bladder);
     for (int a = 0; a < 3; ++a)
     {
       pm->domain.lower[a] = std::max(full.lower[a], lo[a] - 30.0);
       pm->domain.upper[a] = std::min(full.upper[a], hi[a] + 30.0);
     }
-    std::vector<morea::MeshStructure> structures;
+    std::vector<morea_core::MeshStructure> structures;
     for (std::size_t s = 1; s < pm->names.size(); ++s) // all but the body
     {
-      structures.push_back({ pm->names[s], morea::MaskBoundaryPoints(pm->phantomCase.movingMasks[s]),
+      structures.push_back({ pm->names[s], morea_core::MaskBoundaryPoints(pm->phantomCase.movingMasks[s]),
                              &pm->phantomCase.movingMasks[s] });
     }
-    morea::MeshGeneratorOptions options; // 600 points, bladder surface
+    morea_core::MeshGeneratorOptions options; // 600 points, bladder surface
     options.seed = 7;
-    pm->mesh = morea::GenerateMesh(pm->domain, structures, options, &pm->report);
+    pm->mesh = morea_core::GenerateMesh(pm->domain, structures, options, &pm->report);
     return pm;
   }();
   return *cached;

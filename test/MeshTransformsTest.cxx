@@ -21,7 +21,7 @@
 namespace fs = std::filesystem;
 using itk::morea::DomainFrame;
 using itk::morea::PointType;
-using morea::Vec3;
+using morea_core::Vec3;
 
 namespace
 {
@@ -97,8 +97,8 @@ protected:
   // The moving grid covers the fixed one with a margin, on other voxels.
   itk::morea::ImageType::Pointer moving =
     MakeGrid(frame, { { 32.0, 17.0, 7.0 } }, { { 44, 41, 36 } }, { { 1.1, 0.95, 1.05 } });
-  morea_test::BoxMesh box = morea_test::MakeBoxMesh(morea::MeshDomain::OfGrid(frame.FieldGridOf(fixed)), { 4, 4, 3 });
-  morea::MeshTopology topology{ box.tetrahedra, box.points.size() };
+  morea_test::BoxMesh box = morea_test::MakeBoxMesh(morea_core::MeshDomain::OfGrid(frame.FieldGridOf(fixed)), { 4, 4, 3 });
+  morea_core::MeshTopology topology{ box.tetrahedra, box.points.size() };
 
   std::vector<PointType>
   FixedVoxelCentres() const
@@ -144,7 +144,7 @@ TEST_F(MeshTransforms, FrameIsTheRotatedGrid)
 
 TEST_F(MeshTransforms, VolumeConversionsKeepGeometry)
 {
-  morea::Volume<float> volume({ 6, 5, 4 }, { 1.5, 1.0, 2.5 }, { 10.0, -4.0, 7.0 });
+  morea_core::Volume<float> volume({ 6, 5, 4 }, { 1.5, 1.0, 2.5 }, { 10.0, -4.0, 7.0 });
   for (std::size_t i = 0; i < volume.data.size(); ++i)
     volume.data[i] = static_cast<float>(i) * 0.5f;
   const auto                       image = itk::morea::ToImage(volume, frame);
@@ -162,7 +162,7 @@ TEST_F(MeshTransforms, VolumeConversionsKeepGeometry)
     EXPECT_EQ(back.spacing[a], volume.spacing[a]);
   }
 
-  morea::Volume<std::uint8_t> mask = volume.Like<std::uint8_t>(0);
+  morea_core::Volume<std::uint8_t> mask = volume.Like<std::uint8_t>(0);
   mask(2, 2, 2) = 1;
   const auto maskImage = itk::morea::ToMask(mask, frame);
   EXPECT_EQ(itk::morea::ToVolume(maskImage, frame).data, mask.data);
@@ -171,7 +171,7 @@ TEST_F(MeshTransforms, VolumeConversionsKeepGeometry)
 
 TEST_F(MeshTransforms, AffineTargetMapsPhysicalPoints)
 {
-  morea::DualMesh solution;
+  morea_core::DualMesh solution;
   solution.source = box.points;
   for (const auto & q : box.points)
     solution.target.push_back(AffineImage(q));
@@ -228,8 +228,8 @@ TEST_F(MeshTransforms, ComposedDirectionsAreTheIdentity)
   // field misses the kinks between tetrahedra by about (gradient jump) x voxel,
   // while a wrong frame, vector or grid would cost about the displacement itself.
   const auto                coarse = morea_test::MakeBoxMesh(box.domain, { 2, 2, 2 });
-  const morea::MeshTopology coarseTopology(coarse.tetrahedra, coarse.points.size());
-  morea::DualMesh           solution;
+  const morea_core::MeshTopology coarseTopology(coarse.tetrahedra, coarse.points.size());
+  morea_core::DualMesh           solution;
   solution.source = morea_test::Perturb(coarse, 0.05, 13);
   solution.target = coarse.points;
   ASSERT_GT(morea_test::MinimumSignedVolume(coarse.tetrahedra, solution.source), 0.0);
@@ -259,7 +259,7 @@ TEST_F(MeshTransforms, GridsMustShareTheirDirection)
   DomainFrame::DirectionType identity;
   identity.SetIdentity();
   turned->SetDirection(identity);
-  EXPECT_THROW(itk::morea::RasterizeSolution(topology, morea::DualMesh{ box.points, box.points }, fixed, turned),
+  EXPECT_THROW(itk::morea::RasterizeSolution(topology, morea_core::DualMesh{ box.points, box.points }, fixed, turned),
                itk::ExceptionObject);
 }
 
@@ -268,9 +268,9 @@ TEST_F(MeshTransforms, VtuPointsAreInPhysicalSpace)
   const fs::path folder = fs::path(MOREA_TEST_OUTPUT_DIR) / "mesh_transforms";
   fs::remove_all(folder);
   const fs::path  path = folder / "target.vtu";
-  morea::VtuArray volume{ "volume", {} };
+  morea_core::VtuArray volume{ "volume", {} };
   for (const auto & t : box.tetrahedra)
-    volume.values.push_back(morea::SignedVolume(t, box.points));
+    volume.values.push_back(morea_core::SignedVolume(t, box.points));
 
   // A reflection too: the cells must stay positively oriented in physical space.
   DomainFrame::DirectionType mirrored = RotationAboutZ();
@@ -296,11 +296,11 @@ TEST_F(MeshTransforms, VtuPointsAreInPhysicalSpace)
     for (vtkIdType c = 0; c < grid->GetNumberOfCells(); ++c)
     {
       grid->GetCellPoints(c, ids);
-      const morea::Tetrahedron t{ { static_cast<std::uint32_t>(ids->GetId(0)),
+      const morea_core::Tetrahedron t{ { static_cast<std::uint32_t>(ids->GetId(0)),
                                     static_cast<std::uint32_t>(ids->GetId(1)),
                                     static_cast<std::uint32_t>(ids->GetId(2)),
                                     static_cast<std::uint32_t>(ids->GetId(3)) } };
-      EXPECT_NEAR(morea::SignedVolume(t, physical), volume.values[c], 1e-9);
+      EXPECT_NEAR(morea_core::SignedVolume(t, physical), volume.values[c], 1e-9);
     }
     vtkDataArray * read = grid->GetCellData()->GetArray("volume");
     ASSERT_NE(read, nullptr);

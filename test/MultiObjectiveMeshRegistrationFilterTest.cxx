@@ -10,8 +10,8 @@
 #include "itkRegistrationEvaluation.h"
 #include "itkResampleImageFilter.h"
 #include "itkTransformFileReader.h"
-#include "morea/ComputeDevices.h"
-#include "morea/ParetoFront.h"
+#include "morea_core/ComputeDevices.h"
+#include "morea_core/ParetoFront.h"
 
 #include <gtest/gtest.h>
 
@@ -209,18 +209,18 @@ TEST(MultiObjectiveMeshRegistrationFilter, RegistersASyntheticBladderAndReportsE
       EXPECT_LE(set[a - 1].objectives[2], set[a].objectives[2]);
     }
     for (std::size_t b = 0; b < set.size(); ++b)
-      EXPECT_FALSE(::morea::Dominates(set[a].objectives, set[b].objectives)) << set[a] << " dominates " << set[b];
+      EXPECT_FALSE(morea_core::Dominates(set[a].objectives, set[b].objectives)) << set[a] << " dominates " << set[b];
   }
 
   // The chosen solutions: best guidance first, then the knee.
   ASSERT_EQ(filter->GetNumberOfSelectedSolutions(), 2u);
   EXPECT_EQ(filter->GetSelectedSolutionLabel(0), "best_guidance");
   EXPECT_EQ(filter->GetSelectedSolutionLabel(1), "knee");
-  std::vector<::morea::ObjectiveVector> objectives;
+  std::vector<morea_core::ObjectiveVector> objectives;
   for (const auto & s : set)
     objectives.push_back(s.objectives);
-  EXPECT_EQ(filter->GetSelectedSolutionIndex(0), ::morea::SelectBestGuidance(objectives));
-  EXPECT_EQ(filter->GetSelectedSolutionIndex(1), ::morea::SelectKnee(objectives));
+  EXPECT_EQ(filter->GetSelectedSolutionIndex(0), morea_core::SelectBestGuidance(objectives));
+  EXPECT_EQ(filter->GetSelectedSolutionIndex(1), morea_core::SelectKnee(objectives));
   EXPECT_THROW(filter->GetFixedToMovingTransform(2), itk::ExceptionObject);
 
   // Both transforms on the preprocessed grid (one grid: no rigid step, 2 mm already).
@@ -567,7 +567,7 @@ TEST(MultiObjectiveMeshRegistrationFilter, RunsOnTheGpuByDefaultWhenOneIsPresent
   auto fresh = FilterType::New();
   EXPECT_EQ(fresh->GetBackend(), "auto");
   ASSERT_NO_THROW(filter->Update());
-  const std::string unavailable = ::morea::CudaUnavailableReason();
+  const std::string unavailable = morea_core::CudaUnavailableReason();
   if (unavailable.empty())
   {
     EXPECT_EQ(filter->GetBackendUsed(), "cuda-texture");

@@ -4,17 +4,17 @@
 // read is below the radius, and no interpolated distance below the radius
 // falls in an unmarked block (the CUDA sampling skips its distance fetch
 // there).
-#include "morea/NearContourBlocks.h"
-#include "morea/Error.h"
-#include "morea/ObjectiveData.h"
-#include "morea/Random.h"
+#include "morea_core/NearContourBlocks.h"
+#include "morea_core/Error.h"
+#include "morea_core/ObjectiveData.h"
+#include "morea_core/Random.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 
-using namespace morea;
+using namespace morea_core;
 
 namespace
 {

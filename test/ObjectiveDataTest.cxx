@@ -6,7 +6,7 @@
 #include "itkMOREAImageIO.h"
 #include "itkObjectiveData.h"
 #include "itkPreprocessing.h"
-#include "morea/ParameterSet.h"
+#include "morea_core/ParameterSet.h"
 
 #include <gtest/gtest.h>
 
@@ -14,7 +14,7 @@
 #include <random>
 
 using namespace itk::morea;
-using morea::Vec3;
+using morea_core::Vec3;
 
 namespace
 {
@@ -141,7 +141,7 @@ Offset(long i, long j, long k)
 
 /** Max over all voxels of |channel - analytic distance to the sphere (c, r)|. */
 double
-MaxSphereError(const morea::ChannelVolume & volume, std::size_t channel, const itk::ImageBase<3> * grid,
+MaxSphereError(const morea_core::ChannelVolume & volume, std::size_t channel, const itk::ImageBase<3> * grid,
                const PointType & c, double r)
 {
   double worst = 0.0;
@@ -161,13 +161,13 @@ TEST(ObjectiveData, ChannelsHoldTheIntensitiesAndTheGuidanceDistances)
 {
   const RegistrationProblem problem = MakeProblem();
   const MeshModel           model = ModelOn(problem.fixedImage);
-  morea::ParameterSet       parameters;
+  morea_core::ParameterSet       parameters;
   parameters.SetFromString("morea_sampling_rate", "2.5");
-  const morea::ObjectiveData data = BuildObjectiveData(problem, model, parameters);
+  const morea_core::ObjectiveData data = BuildObjectiveData(problem, model, parameters);
 
   ASSERT_EQ(data.guidanceNames, (std::vector<std::string>{ "liver", "bladder" }));
   ASSERT_EQ(data.NumberOfGuidanceStructures(), 2u);
-  for (const morea::ChannelVolume * v : { &data.fixed, &data.moving })
+  for (const morea_core::ChannelVolume * v : { &data.fixed, &data.moving })
   {
     ASSERT_EQ(v->channels, 3u);
     ASSERT_EQ(v->data.size(), 3u * N * N * N);
@@ -228,8 +228,8 @@ TEST(ObjectiveData, ChannelsHoldTheIntensitiesAndTheGuidanceDistances)
 TEST(ObjectiveData, SampleInterpolatesTheStoredChannels)
 {
   const RegistrationProblem  problem = MakeProblem();
-  const morea::ObjectiveData data = BuildObjectiveData(problem, ModelOn(problem.fixedImage), morea::ParameterSet());
-  const morea::ChannelVolume & v = data.moving;
+  const morea_core::ObjectiveData data = BuildObjectiveData(problem, ModelOn(problem.fixedImage), morea_core::ParameterSet());
+  const morea_core::ChannelVolume & v = data.moving;
   std::mt19937                 random(7);
   std::uniform_int_distribution<long> index(0, N - 2);
   for (int trial = 0; trial < 200; ++trial)
@@ -259,9 +259,9 @@ TEST(ObjectiveData, GuidanceSelectionAndDisabling)
   const RegistrationProblem problem = MakeProblem();
   const MeshModel           model = ModelOn(problem.fixedImage);
 
-  morea::ParameterSet disabled;
+  morea_core::ParameterSet disabled;
   disabled.SetFromString("problem_guidance_enabled", "false");
-  const morea::ObjectiveData none = BuildObjectiveData(problem, model, disabled);
+  const morea_core::ObjectiveData none = BuildObjectiveData(problem, model, disabled);
   EXPECT_EQ(none.fixed.channels, 1u);
   EXPECT_EQ(none.moving.channels, 1u);
   EXPECT_EQ(none.fixed.data.size(), std::size_t{ N } * N * N);
@@ -269,9 +269,9 @@ TEST(ObjectiveData, GuidanceSelectionAndDisabling)
   EXPECT_EQ(none.NumberOfGuidanceStructures(), 0u);
 
   // An explicit selection sets the channel order; "body" can be chosen by name.
-  morea::ParameterSet selected;
+  morea_core::ParameterSet selected;
   selected.SetFromString("problem_guidance_selection", "bladder,body");
-  const morea::ObjectiveData two = BuildObjectiveData(problem, model, selected);
+  const morea_core::ObjectiveData two = BuildObjectiveData(problem, model, selected);
   ASSERT_EQ(two.guidanceNames, (std::vector<std::string>{ "bladder", "body" }));
   EXPECT_EQ(two.fixed.channels, 3u);
   EXPECT_NEAR(two.fixed.data[3 * Offset(20, 20, 20) + 2], 25.0, 0.5 * Spacing);
@@ -282,7 +282,7 @@ TEST(ObjectiveData, MissingGuidanceDataThrows)
 {
   const MeshModel model = ModelOn(MakeProblem().fixedImage);
 
-  morea::ParameterSet unknown;
+  morea_core::ParameterSet unknown;
   unknown.SetFromString("problem_guidance_selection", "liver,stomach");
   EXPECT_THROW(BuildObjectiveData(MakeProblem(), model, unknown), itk::ExceptionObject);
 
@@ -290,7 +290,7 @@ TEST(ObjectiveData, MissingGuidanceDataThrows)
   noMovingSide.structures[2].movingPoints.clear();
   try
   {
-    BuildObjectiveData(noMovingSide, model, morea::ParameterSet());
+    BuildObjectiveData(noMovingSide, model, morea_core::ParameterSet());
     FAIL() << "a guidance structure without moving data was accepted";
   }
   catch (const itk::ExceptionObject & e)
@@ -303,17 +303,17 @@ TEST(ObjectiveData, MissingGuidanceDataThrows)
   // An empty mask without points is as good as none.
   RegistrationProblem emptyMask = MakeProblem();
   emptyMask.structures[0].fixedMask->FillBuffer(0);
-  EXPECT_THROW(BuildObjectiveData(emptyMask, model, morea::ParameterSet()), itk::ExceptionObject);
+  EXPECT_THROW(BuildObjectiveData(emptyMask, model, morea_core::ParameterSet()), itk::ExceptionObject);
 
   // Not preprocessed: the images on different grids.
   RegistrationProblem otherGrid = MakeProblem();
   auto                origin = otherGrid.movingImage->GetOrigin();
   origin[1] += 3.0;
   otherGrid.movingImage->SetOrigin(origin);
-  EXPECT_THROW(BuildObjectiveData(otherGrid, model, morea::ParameterSet()), itk::ExceptionObject);
+  EXPECT_THROW(BuildObjectiveData(otherGrid, model, morea_core::ParameterSet()), itk::ExceptionObject);
 
   // Guidance disabled: structures are not looked at.
-  morea::ParameterSet disabled;
+  morea_core::ParameterSet disabled;
   disabled.SetFromString("problem_guidance_enabled", "false");
   EXPECT_NO_THROW(BuildObjectiveData(noMovingSide, model, disabled));
 }
@@ -328,7 +328,7 @@ TEST(ObjectiveData, RotatedGridIsSampledInTheDomainFrame)
   const DomainFrame         frame(d);
   const RegistrationProblem problem = MakeProblem(frame);
   const MeshModel           model = ModelOn(problem.fixedImage);
-  const auto                data = BuildObjectiveData(problem, model, morea::ParameterSet());
+  const auto                data = BuildObjectiveData(problem, model, morea_core::ParameterSet());
 
   const auto * g = problem.fixedImage.GetPointer();
   for (int a = 0; a < 3; ++a)
@@ -344,7 +344,7 @@ TEST(ObjectiveData, RotatedGridIsSampledInTheDomainFrame)
   EXPECT_NEAR(out[1], Radius, 0.5 * Spacing);
 
   // A model in another frame does not fit.
-  EXPECT_THROW(BuildObjectiveData(problem, MeshModel(), morea::ParameterSet()), itk::ExceptionObject);
+  EXPECT_THROW(BuildObjectiveData(problem, MeshModel(), morea_core::ParameterSet()), itk::ExceptionObject);
 }
 
 TEST(ObjectiveData, DistanceMapOfAMaskFillingTheGridIsToItsEdge)

@@ -4,13 +4,13 @@
 // changed: more clusters than solutions.
 #include "OptimiserTestProblem.h"
 
-#include "morea/Error.h"
+#include "morea_core/Error.h"
 
 #include <gtest/gtest.h>
 
 namespace
 {
-using namespace morea;
+using namespace morea_core;
 
 TEST(OptimiserOptions, MoreClustersThanSolutionsAreRefused)
 {

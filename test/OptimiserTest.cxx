@@ -5,8 +5,8 @@
 // exactly, and the optimiser makes progress.
 #include "OptimiserTestProblem.h"
 
-#include "morea/CheckpointWriter.h"
-#include "morea/Error.h"
+#include "morea_core/CheckpointWriter.h"
+#include "morea_core/Error.h"
 
 #include <gtest/gtest.h>
 
@@ -22,7 +22,7 @@
 #include <sstream>
 #include <utility>
 
-using namespace morea;
+using namespace morea_core;
 using morea_test::OptimiserTestProblem;
 
 namespace

@@ -9,14 +9,14 @@
 
 #include "BoxMesh.h"
 
-#include "morea/EvaluationBackend.h"
-#include "morea/FoldConstraint.h"
-#include "morea/InitialPopulation.h"
-#include "morea/MoRvGomea.h"
-#include "morea/ObjectiveData.h"
-#include "morea/ParallelStructure.h"
-#include "morea/Random.h"
-#include "morea/TetrahedronObjectives.h"
+#include "morea_core/EvaluationBackend.h"
+#include "morea_core/FoldConstraint.h"
+#include "morea_core/InitialPopulation.h"
+#include "morea_core/MoRvGomea.h"
+#include "morea_core/ObjectiveData.h"
+#include "morea_core/ParallelStructure.h"
+#include "morea_core/Random.h"
+#include "morea_core/TetrahedronObjectives.h"
 
 #include <cmath>
 #include <memory>
@@ -25,10 +25,10 @@
 
 namespace morea_test
 {
-inline morea::ChannelVolume
-BallImage(const morea::Vec3 & centre, double radius, double spacing, std::size_t size)
+inline morea_core::ChannelVolume
+BallImage(const morea_core::Vec3 & centre, double radius, double spacing, std::size_t size)
 {
-  morea::ChannelVolume v;
+  morea_core::ChannelVolume v;
   v.size = { size, size, size };
   v.spacing = { spacing, spacing, spacing };
   v.origin = { 0.0, 0.0, 0.0 };
@@ -53,18 +53,18 @@ BallImage(const morea::Vec3 & centre, double radius, double spacing, std::size_t
 
 struct OptimiserTestProblem
 {
-  morea::TetrahedralMesh               base;
-  morea::MeshTopology                  topology;
-  morea::ParallelStructure             parallel;
-  std::unique_ptr<morea::FoldConstraint> constraint;
+  morea_core::TetrahedralMesh               base;
+  morea_core::MeshTopology                  topology;
+  morea_core::ParallelStructure             parallel;
+  std::unique_ptr<morea_core::FoldConstraint> constraint;
   std::vector<double>                  elasticity;
-  morea::RigidityModel                 rigidity;
-  morea::ObjectiveData                 data;
-  std::unique_ptr<morea::TetrahedronEvaluator> evaluator;
+  morea_core::RigidityModel                 rigidity;
+  morea_core::ObjectiveData                 data;
+  std::unique_ptr<morea_core::TetrahedronEvaluator> evaluator;
 
   OptimiserTestProblem()
   {
-    morea::MeshDomain domain;
+    morea_core::MeshDomain domain;
     domain.lower = { 0.0, 0.0, 0.0 };
     domain.upper = { 30.0, 30.0, 30.0 };
     const BoxMesh box = MakeBoxMesh(domain, { 4, 4, 4 });
@@ -73,13 +73,13 @@ struct OptimiserTestProblem
     base.tetrahedra = box.tetrahedra;
     for (const auto & p : base.points)
     {
-      base.pins.push_back(morea::PinOf(p, domain, 1e-9));
-      base.origins.push_back(morea::PointOrigin::Random);
+      base.pins.push_back(morea_core::PinOf(p, domain, 1e-9));
+      base.origins.push_back(morea_core::PointOrigin::Random);
       base.structures.push_back(-1);
     }
-    topology = morea::MeshTopology(base.tetrahedra, base.points.size());
-    parallel = morea::BuildParallelStructure(topology);
-    constraint = std::make_unique<morea::FoldConstraint>(topology, base.points);
+    topology = morea_core::MeshTopology(base.tetrahedra, base.points.size());
+    parallel = morea_core::BuildParallelStructure(topology);
+    constraint = std::make_unique<morea_core::FoldConstraint>(topology, base.points);
     elasticity.assign(topology.NumberOfTetrahedra(), 1.0);
     data.fixed = BallImage({ 15.0, 15.0, 15.0 }, 6.0, 1.0, 31);
     data.moving = BallImage({ 17.0, 15.0, 14.0 }, 7.5, 1.0, 31);
@@ -88,7 +88,7 @@ struct OptimiserTestProblem
     data.guidanceRadius = 3.0;
     data.samplingRate = 0.25;
     data.voxelVolume = 1.0;
-    evaluator = std::make_unique<morea::TetrahedronEvaluator>(topology, *constraint, elasticity, data);
+    evaluator = std::make_unique<morea_core::TetrahedronEvaluator>(topology, *constraint, elasticity, data);
   }
 
   /** `n` guidance structures in place of the ball: structure g is a sphere
@@ -98,7 +98,7 @@ struct OptimiserTestProblem
   void
   UseStructures(std::size_t n)
   {
-    const auto rebuild = [n](morea::ChannelVolume & image, const morea::Vec3 & centre, double radius) {
+    const auto rebuild = [n](morea_core::ChannelVolume & image, const morea_core::Vec3 & centre, double radius) {
       const std::size_t    voxels = image.size[0] * image.size[1] * image.size[2];
       std::vector<float>   out((1 + n) * voxels);
       const double         pi = 3.14159265358979323846;
@@ -107,13 +107,13 @@ struct OptimiserTestProblem
         out[(1 + n) * v] = image.data[image.channels * v];
         const std::size_t i = v % image.size[0], j = v / image.size[0] % image.size[1],
                           k = v / (image.size[0] * image.size[1]);
-        const morea::Vec3 x{ { image.origin[0] + image.spacing[0] * static_cast<double>(i),
+        const morea_core::Vec3 x{ { image.origin[0] + image.spacing[0] * static_cast<double>(i),
                                image.origin[1] + image.spacing[1] * static_cast<double>(j),
                                image.origin[2] + image.spacing[2] * static_cast<double>(k) } };
         for (std::size_t g = 0; g < n; ++g)
         {
           const double angle = 2.0 * pi * static_cast<double>(g) / static_cast<double>(n);
-          const morea::Vec3 c{ { centre[0] + 4.0 * std::cos(angle), centre[1] + 4.0 * std::sin(angle),
+          const morea_core::Vec3 c{ { centre[0] + 4.0 * std::cos(angle), centre[1] + 4.0 * std::sin(angle),
                                  centre[2] + 1.5 * (static_cast<double>(g % 3) - 1.0) } };
           const double r = std::sqrt((x[0] - c[0]) * (x[0] - c[0]) + (x[1] - c[1]) * (x[1] - c[1]) +
                                      (x[2] - c[2]) * (x[2] - c[2]));
@@ -153,14 +153,14 @@ struct OptimiserTestProblem
         x += 0.25 * base.points[p][0];
       fraction[t] = x < 10.0 ? 1.0 : x < 15.0 ? 0.5 : 0.0;
     }
-    rigidity = morea::BuildRigidityModel(base, fraction, weight, strainLimit);
-    evaluator = std::make_unique<morea::TetrahedronEvaluator>(topology, *constraint, elasticity, rigidity, data);
+    rigidity = morea_core::BuildRigidityModel(base, fraction, weight, strainLimit);
+    evaluator = std::make_unique<morea_core::TetrahedronEvaluator>(topology, *constraint, elasticity, rigidity, data);
   }
 
-  morea::GomeaOptions
+  morea_core::GomeaOptions
   Options(std::uint64_t seed = 5, std::size_t generations = 8) const
   {
-    morea::GomeaOptions o;
+    morea_core::GomeaOptions o;
     o.populationSize = 24;
     o.numberOfClusters = 3;
     o.archiveCapacity = 40;
@@ -171,10 +171,10 @@ struct OptimiserTestProblem
     return o;
   }
 
-  std::vector<morea::DualMesh>
-  InitialPopulation(const morea::GomeaOptions & o) const
+  std::vector<morea_core::DualMesh>
+  InitialPopulation(const morea_core::GomeaOptions & o) const
   {
-    return morea::GenerateInitialPopulation(base, *constraint, o.populationSize, o.seed);
+    return morea_core::GenerateInitialPopulation(base, *constraint, o.populationSize, o.seed);
   }
 };
 
@@ -184,35 +184,35 @@ struct OptimiserTestProblem
  *  candidates point into it, so it is neither copied nor moved). */
 struct RandomCandidates
 {
-  std::vector<std::vector<morea::Vec3>>              source, target;
-  std::vector<std::vector<morea::TetrahedronValues>> values;
-  std::vector<morea::CandidateFolds>                 folds;
-  std::vector<morea::PartialCandidate>               candidates;
+  std::vector<std::vector<morea_core::Vec3>>              source, target;
+  std::vector<std::vector<morea_core::TetrahedronValues>> values;
+  std::vector<morea_core::CandidateFolds>                 folds;
+  std::vector<morea_core::PartialCandidate>               candidates;
 
-  RandomCandidates(const OptimiserTestProblem & problem, const std::vector<morea::DualMesh> & parents,
+  RandomCandidates(const OptimiserTestProblem & problem, const std::vector<morea_core::DualMesh> & parents,
                    const std::vector<std::uint32_t> & group, double sigma, std::uint64_t seed)
   {
-    morea::RandomGenerator random(seed);
-    for (const morea::DualMesh & parent : parents)
+    morea_core::RandomGenerator random(seed);
+    for (const morea_core::DualMesh & parent : parents)
       for (std::uint32_t e : group)
       {
-        const morea::FosElement & element = problem.parallel.elements[e];
-        std::vector<morea::Vec3>  s, t;
+        const morea_core::FosElement & element = problem.parallel.elements[e];
+        std::vector<morea_core::Vec3>  s, t;
         for (std::uint32_t p : element.points)
         {
-          morea::Vec3 a = parent.source[p], b = parent.target[p];
+          morea_core::Vec3 a = parent.source[p], b = parent.target[p];
           for (int axis = 0; axis < 3; ++axis)
           {
             a[axis] += sigma * random.Normal();
             b[axis] += sigma * random.Normal();
           }
-          s.push_back(morea::ProjectToDomain(a, problem.base.pins[p], problem.base.domain));
-          t.push_back(morea::ProjectToDomain(b, problem.base.pins[p], problem.base.domain));
+          s.push_back(morea_core::ProjectToDomain(a, problem.base.pins[p], problem.base.domain));
+          t.push_back(morea_core::ProjectToDomain(b, problem.base.pins[p], problem.base.domain));
         }
         source.push_back(std::move(s));
         target.push_back(std::move(t));
         values.emplace_back(element.dependentTetrahedra.size());
-        morea::PartialCandidate c;
+        morea_core::PartialCandidate c;
         c.parent = &parent;
         c.element = &element;
         c.seed = random.NextU64();
@@ -233,11 +233,11 @@ struct RandomCandidates
 
   /** One side of candidate i as a whole mesh side: the parent's points with
    *  the element's replaced. */
-  std::vector<morea::Vec3>
+  std::vector<morea_core::Vec3>
   Side(std::size_t i, int side) const
   {
-    const morea::PartialCandidate & c = candidates[i];
-    std::vector<morea::Vec3>        points = side == 0 ? c.parent->source : c.parent->target;
+    const morea_core::PartialCandidate & c = candidates[i];
+    std::vector<morea_core::Vec3>        points = side == 0 ? c.parent->source : c.parent->target;
     for (std::size_t k = 0; k < c.element->points.size(); ++k)
       points[c.element->points[k]] = side == 0 ? c.source[k] : c.target[k];
     return points;

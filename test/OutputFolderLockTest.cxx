@@ -1,7 +1,7 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/Error.h"
-#include "morea/OutputFolderLock.h"
+#include "morea_core/Error.h"
+#include "morea_core/OutputFolderLock.h"
 
 #include <gtest/gtest.h>
 
@@ -30,9 +30,9 @@ RefusalOf(const std::filesystem::path & folder)
 {
   try
   {
-    const morea::OutputFolderLock lock(folder.string());
+    const morea_core::OutputFolderLock lock(folder.string());
   }
-  catch (const morea::Error & e)
+  catch (const morea_core::Error & e)
   {
     return e.what();
   }
@@ -44,7 +44,7 @@ TEST(OutputFolderLock, CreatesTheFolderAndExcludesASecondOwnerUntilReleased)
 {
   const auto folder = FreshFolder("nested/run");
   {
-    std::optional<morea::OutputFolderLock> first(std::in_place, folder.string());
+    std::optional<morea_core::OutputFolderLock> first(std::in_place, folder.string());
     EXPECT_TRUE(std::filesystem::is_directory(folder));
     const std::string refusal = RefusalOf(folder);
     EXPECT_NE(refusal.find("is in use by another run (process " + std::to_string(::getpid()) + ")"), std::string::npos)
@@ -66,7 +66,7 @@ TEST(OutputFolderLock, AnotherProcessHoldingItRefusesAndItsEndFreesTheFolder)
   {
     // Holds the folder until the parent kills it: it never releases the lock itself.
     ::close(ready[0]);
-    const morea::OutputFolderLock lock(folder.string());
+    const morea_core::OutputFolderLock lock(folder.string());
     char                          byte = 1;
     (void)!::write(ready[1], &byte, 1);
     ::close(ready[1]);

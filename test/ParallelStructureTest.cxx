@@ -3,7 +3,7 @@
 // Tests of the linkage model: edge set cover, interaction graph, DSATUR groups.
 #include "MeshTestSupport.h"
 
-#include "morea/ParallelStructure.h"
+#include "morea_core/ParallelStructure.h"
 
 #include <gtest/gtest.h>
 
@@ -42,7 +42,7 @@ ExpectProperColouring(const std::vector<std::vector<std::uint32_t>> & g, const s
 TEST(ParallelStructure, DsaturColoursCyclesAndCliquesOptimally)
 {
   const auto even = Cycle(10), odd = Cycle(9);
-  const auto ce = morea::DsaturColouring(even), co = morea::DsaturColouring(odd);
+  const auto ce = morea_core::DsaturColouring(even), co = morea_core::DsaturColouring(odd);
   ExpectProperColouring(even, ce);
   ExpectProperColouring(odd, co);
   EXPECT_EQ(ColourCount(ce), 2u);
@@ -52,7 +52,7 @@ TEST(ParallelStructure, DsaturColoursCyclesAndCliquesOptimally)
     for (std::uint32_t j = 0; j < 5; ++j)
       if (i != j)
         k5[i].push_back(j);
-  EXPECT_EQ(ColourCount(morea::DsaturColouring(k5)), 5u);
+  EXPECT_EQ(ColourCount(morea_core::DsaturColouring(k5)), 5u);
   // A crown graph (complete bipartite minus a perfect matching) defeats
   // greedy colouring in index order; DSATUR colours it with 2.
   std::vector<std::vector<std::uint32_t>> crown(12);
@@ -63,18 +63,18 @@ TEST(ParallelStructure, DsaturColoursCyclesAndCliquesOptimally)
         crown[2 * i].push_back(2 * j + 1);
         crown[2 * j + 1].push_back(2 * i);
       }
-  const auto cc = morea::DsaturColouring(crown);
+  const auto cc = morea_core::DsaturColouring(crown);
   ExpectProperColouring(crown, cc);
   EXPECT_EQ(ColourCount(cc), 2u);
 }
 
 TEST(ParallelStructure, InteractionMeansSharedTetrahedra)
 {
-  std::vector<morea::FosElement> elements(3);
+  std::vector<morea_core::FosElement> elements(3);
   elements[0].dependentTetrahedra = { 0, 1 };
   elements[1].dependentTetrahedra = { 1, 2 };
   elements[2].dependentTetrahedra = { 3 };
-  const auto g = morea::InteractionGraph(elements, 4);
+  const auto g = morea_core::InteractionGraph(elements, 4);
   EXPECT_EQ(g[0], (std::vector<std::uint32_t>{ 1 }));
   EXPECT_EQ(g[1], (std::vector<std::uint32_t>{ 0 }));
   EXPECT_TRUE(g[2].empty());
@@ -83,8 +83,8 @@ TEST(ParallelStructure, InteractionMeansSharedTetrahedra)
 TEST(ParallelStructure, PhantomMeshCoverAndGroups)
 {
   const auto &              pm = morea_test::PhantomMesh600();
-  const morea::MeshTopology topology(pm.mesh.tetrahedra, pm.mesh.NumberOfPoints());
-  const auto                structure = morea::BuildParallelStructure(topology);
+  const morea_core::MeshTopology topology(pm.mesh.tetrahedra, pm.mesh.NumberOfPoints());
+  const auto                structure = morea_core::BuildParallelStructure(topology);
 
   // Every point is covered; every element is a mesh edge.
   std::vector<int> coveredBy(topology.NumberOfPoints(), 0);
@@ -92,8 +92,8 @@ TEST(ParallelStructure, PhantomMeshCoverAndGroups)
   for (const auto & e : structure.elements)
   {
     ASSERT_EQ(e.points.size(), 2u);
-    EXPECT_TRUE(std::binary_search(edges.begin(), edges.end(), morea::Edge{ { e.points[0], e.points[1] } }));
-    EXPECT_EQ(e.dependentTetrahedra, morea::DependentTetrahedra(topology, e.points));
+    EXPECT_TRUE(std::binary_search(edges.begin(), edges.end(), morea_core::Edge{ { e.points[0], e.points[1] } }));
+    EXPECT_EQ(e.dependentTetrahedra, morea_core::DependentTetrahedra(topology, e.points));
     for (auto p : e.points)
       ++coveredBy[p];
   }

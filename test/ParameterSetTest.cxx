@@ -1,10 +1,10 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-// Tests of morea::ParameterSet (the TOML parameter reader) and morea::RandomGenerator.
+// Tests of morea_core::ParameterSet (the TOML parameter reader) and morea_core::RandomGenerator.
 // Core tests: no ITK headers here.
-#include "morea/Error.h"
-#include "morea/ParameterSet.h"
-#include "morea/Random.h"
+#include "morea_core/Error.h"
+#include "morea_core/ParameterSet.h"
+#include "morea_core/Random.h"
 
 #include <gtest/gtest.h>
 
@@ -20,9 +20,9 @@
 
 namespace
 {
-using morea::Error;
-using morea::ParameterSet;
-using morea::ParameterSpec;
+using morea_core::Error;
+using morea_core::ParameterSet;
+using morea_core::ParameterSpec;
 
 // The MOREA paper's parameter file (appendix A, listing "Parameter file used as
 // basis for the main MOREA experiments"), verbatim.
@@ -68,7 +68,7 @@ morea_num_disruption_kernels = 0
 morea_disruption_frequency = 0
 )";
 
-/** The message of the morea::Error thrown by `f`; fails the test when none is thrown. */
+/** The message of the morea_core::Error thrown by `f`; fails the test when none is thrown. */
 template <typename F>
 std::string
 ErrorMessage(F && f)
@@ -83,10 +83,10 @@ ErrorMessage(F && f)
   }
   catch (const std::exception & e)
   {
-    ADD_FAILURE() << "expected morea::Error, got another exception: " << e.what();
+    ADD_FAILURE() << "expected morea_core::Error, got another exception: " << e.what();
     return "";
   }
-  ADD_FAILURE() << "expected morea::Error, nothing was thrown";
+  ADD_FAILURE() << "expected morea_core::Error, nothing was thrown";
   return "";
 }
 
@@ -309,12 +309,12 @@ TEST(ParameterSet, PlaceholdersInLiteralStrings)
 
 TEST(ParameterSet, SubstitutePlaceholdersReportsLineAndKeepsText)
 {
-  EXPECT_EQ(morea::SubstitutePlaceholders("a = \"$x$y\"\nb = 1 # $z\n", { { "x", "1" }, { "y", "2" } }, "s"),
+  EXPECT_EQ(morea_core::SubstitutePlaceholders("a = \"$x$y\"\nb = 1 # $z\n", { { "x", "1" }, { "y", "2" } }, "s"),
             "a = \"12\"\nb = 1 # $z\n");
   // A lone '$' (no name) is kept as is.
-  EXPECT_EQ(morea::SubstitutePlaceholders("a = \"5 $\"\n", {}, "s"), "a = \"5 $\"\n");
+  EXPECT_EQ(morea_core::SubstitutePlaceholders("a = \"5 $\"\n", {}, "s"), "a = \"5 $\"\n");
   const std::string message =
-    ErrorMessage([] { morea::SubstitutePlaceholders("a = 1\n\nb = \"$missing_var\"\n", {}, "src"); });
+    ErrorMessage([] { morea_core::SubstitutePlaceholders("a = 1\n\nb = \"$missing_var\"\n", {}, "src"); });
   EXPECT_CONTAINS(message, "src line 3");
   EXPECT_CONTAINS(message, "'$missing_var'");
 }
@@ -521,11 +521,11 @@ TEST(Random, MatchesTheReferenceXoshiro256StarStar)
 {
   // Reference values from an independent implementation of SplitMix64 seeding
   // and xoshiro256** (Blackman & Vigna).
-  morea::RandomGenerator zero(0);
+  morea_core::RandomGenerator zero(0);
   EXPECT_EQ(zero.NextU64(), 0x99ec5f36cb75f2b4ULL);
   EXPECT_EQ(zero.NextU64(), 0xbf6e1f784956452aULL);
   EXPECT_EQ(zero.NextU64(), 0x1a5f849d4933e6e0ULL);
-  morea::RandomGenerator fortyTwo(42);
+  morea_core::RandomGenerator fortyTwo(42);
   EXPECT_EQ(fortyTwo.NextU64(), 0x15780b2e0c2ec716ULL);
   EXPECT_EQ(fortyTwo.NextU64(), 0x6104d9866d113a7eULL);
   EXPECT_EQ(fortyTwo.NextU64(), 0xae17533239e499a1ULL);
@@ -533,7 +533,7 @@ TEST(Random, MatchesTheReferenceXoshiro256StarStar)
 
 TEST(Random, SameSeedSameSequenceDifferentSeedDifferent)
 {
-  morea::RandomGenerator a(12345), b(12345), c(12346);
+  morea_core::RandomGenerator a(12345), b(12345), c(12346);
   int                    sameAsC = 0;
   for (int i = 0; i < 1000; ++i)
   {
@@ -553,7 +553,7 @@ TEST(Random, SameSeedSameSequenceDifferentSeedDifferent)
 
 TEST(Random, UniformHasTheRightRangeMeanAndVariance)
 {
-  morea::RandomGenerator g(7);
+  morea_core::RandomGenerator g(7);
   const int              n = 200000;
   double                 sum = 0.0, sum2 = 0.0;
   double                 lo = 1.0, hi = 0.0;
@@ -593,7 +593,7 @@ TEST(Random, UniformHasTheRightRangeMeanAndVariance)
 
 TEST(Random, NormalIsStandardNormal)
 {
-  morea::RandomGenerator g(2023);
+  morea_core::RandomGenerator g(2023);
   const int              n = 400000;
   double                 sum = 0.0, sum2 = 0.0, sum3 = 0.0, sum4 = 0.0;
   int                    withinOne = 0, beyondThree = 0;
@@ -621,7 +621,7 @@ TEST(Random, NormalIsStandardNormal)
 TEST(Random, NormalPairsAreUncorrelated)
 {
   // Box-Muller hands out cos and sin of the same angle in turn: they must be uncorrelated.
-  morea::RandomGenerator g(99);
+  morea_core::RandomGenerator g(99);
   const int              n = 200000;
   double                 sxy = 0.0;
   for (int i = 0; i < n; ++i)
@@ -635,10 +635,10 @@ TEST(Random, NormalPairsAreUncorrelated)
 
 TEST(Random, HashCombineIsDeterministicAndOrderSensitive)
 {
-  EXPECT_EQ(morea::HashCombine(1, 2), morea::HashCombine(1, 2));
-  EXPECT_NE(morea::HashCombine(1, 2), morea::HashCombine(2, 1));
-  EXPECT_NE(morea::HashCombine(1, 2), morea::HashCombine(1, 3));
-  EXPECT_NE(morea::HashCombine(0, 0), 0u);
+  EXPECT_EQ(morea_core::HashCombine(1, 2), morea_core::HashCombine(1, 2));
+  EXPECT_NE(morea_core::HashCombine(1, 2), morea_core::HashCombine(2, 1));
+  EXPECT_NE(morea_core::HashCombine(1, 2), morea_core::HashCombine(1, 3));
+  EXPECT_NE(morea_core::HashCombine(0, 0), 0u);
 }
 
 TEST(Random, HashCombineHasNoCollisionsForSmallInputs)
@@ -648,6 +648,6 @@ TEST(Random, HashCombineHasNoCollisionsForSmallInputs)
   std::set<std::uint64_t> seen;
   for (std::uint64_t seed = 0; seed < 200; ++seed)
     for (std::uint64_t stream = 0; stream < 400; ++stream)
-      seen.insert(morea::HashCombine(seed, stream));
+      seen.insert(morea_core::HashCombine(seed, stream));
   EXPECT_EQ(seen.size(), 200u * 400u);
 }

@@ -2,9 +2,9 @@
 // SPDX-License-Identifier: Apache-2.0
 // The parent store's bookkeeping: held parents are not uploaded again, slots
 // of parents a batch does not name are reused, equal keys share a slot.
-#include "morea/ParentSlots.h"
+#include "morea_core/ParentSlots.h"
 
-#include "morea/Error.h"
+#include "morea_core/Error.h"
 
 #include <gtest/gtest.h>
 
@@ -12,7 +12,7 @@
 
 namespace
 {
-using morea::ParentSlots;
+using morea_core::ParentSlots;
 
 TEST(ParentSlots, FirstBatchUploadsEveryParentIntoItsOwnSlot)
 {
@@ -117,7 +117,7 @@ TEST(ParentSlots, ABatchAssignedInTwoCallsKeepsTheFirstCallsSlots)
   EXPECT_GE(grown.capacity, 6u);
   const auto more = slots.AssignRest({ 21, 22, 23, 24, 25 });
   EXPECT_EQ(more.upload.size(), 5u);
-  EXPECT_THROW(slots.AssignRest({ 26 }), morea::Error);
-  EXPECT_THROW(ParentSlots().AssignRest({ 1 }), morea::Error);
+  EXPECT_THROW(slots.AssignRest({ 26 }), morea_core::Error);
+  EXPECT_THROW(ParentSlots().AssignRest({ 1 }), morea_core::Error);
 }
 } // namespace

@@ -2,9 +2,9 @@
 // SPDX-License-Identifier: Apache-2.0
 // Tests of dominance, non-dominated sorting, the hypervolume and the
 // single-solution selections of morea/ParetoFront.h. Core tests: no ITK.
-#include "morea/Error.h"
-#include "morea/ParetoFront.h"
-#include "morea/Random.h"
+#include "morea_core/Error.h"
+#include "morea_core/ParetoFront.h"
+#include "morea_core/Random.h"
 
 #include <gtest/gtest.h>
 
@@ -17,8 +17,8 @@
 
 namespace
 {
-using morea::Fitness;
-using morea::ObjectiveVector;
+using morea_core::Fitness;
+using morea_core::ObjectiveVector;
 
 Fitness
 Feasible(double a, double b, double c)
@@ -65,7 +65,7 @@ GridHypervolume(const std::vector<ObjectiveVector> & points, const ObjectiveVect
 
 TEST(ParetoFront, Dominance)
 {
-  using morea::Dominates;
+  using morea_core::Dominates;
   EXPECT_TRUE(Dominates({ { 1, 2, 3 } }, { { 1, 2, 4 } }));
   EXPECT_TRUE(Dominates({ { 0, 0, 0 } }, { { 1, 1, 1 } }));
   EXPECT_FALSE(Dominates({ { 1, 2, 3 } }, { { 1, 2, 3 } })); // equal: no strict improvement
@@ -76,7 +76,7 @@ TEST(ParetoFront, Dominance)
 
 TEST(ParetoFront, ConstraintDomination)
 {
-  using morea::ConstraintDominates;
+  using morea_core::ConstraintDominates;
   // Feasible beats infeasible whatever the objectives.
   EXPECT_TRUE(ConstraintDominates(Feasible(9, 9, 9), Infeasible(0.1, 0, 0, 0)));
   EXPECT_FALSE(ConstraintDominates(Infeasible(0.1, 0, 0, 0), Feasible(9, 9, 9)));
@@ -103,16 +103,16 @@ TEST(ParetoFront, RanksUnderConstraintDomination)
     Feasible(1, 1, 1),         // 7: duplicate of 0 -> same rank
     Feasible(2.5, 2.5, 0.5),   // 8: dominated by none of 0, 2 -> first front
   };
-  EXPECT_EQ(morea::NonDominatedRanks(population), (std::vector<std::size_t>{ 0, 1, 0, 2, 3, 4, 3, 0, 0 }));
-  EXPECT_TRUE(morea::NonDominatedRanks({}).empty());
-  EXPECT_EQ(morea::NonDominatedRanks({ Infeasible(3.0) }), (std::vector<std::size_t>{ 0 }));
+  EXPECT_EQ(morea_core::NonDominatedRanks(population), (std::vector<std::size_t>{ 0, 1, 0, 2, 3, 4, 3, 0, 0 }));
+  EXPECT_TRUE(morea_core::NonDominatedRanks({}).empty());
+  EXPECT_EQ(morea_core::NonDominatedRanks({ Infeasible(3.0) }), (std::vector<std::size_t>{ 0 }));
 }
 
 TEST(ParetoFront, RanksAgreeWithDefinitionOnRandomPopulation)
 {
   // Rank r: dominated only by solutions of rank < r, and by one of rank r - 1.
   // Every other solution on a coarse grid: equal objectives and ties in some.
-  morea::RandomGenerator random(7);
+  morea_core::RandomGenerator random(7);
   std::vector<Fitness>   population;
   for (int i = 0; i < 300; ++i)
   {
@@ -126,12 +126,12 @@ TEST(ParetoFront, RanksAgreeWithDefinitionOnRandomPopulation)
     }
     population.push_back(f);
   }
-  const auto ranks = morea::NonDominatedRanks(population);
+  const auto ranks = morea_core::NonDominatedRanks(population);
   for (std::size_t i = 0; i < population.size(); ++i)
   {
     bool dominatedByPreviousRank = false;
     for (std::size_t k = 0; k < population.size(); ++k)
-      if (morea::ConstraintDominates(population[k], population[i]))
+      if (morea_core::ConstraintDominates(population[k], population[i]))
       {
         ASSERT_LT(ranks[k], ranks[i]);
         dominatedByPreviousRank = dominatedByPreviousRank || ranks[k] + 1 == ranks[i];
@@ -158,7 +158,7 @@ RanksByPeeling(const std::vector<Fitness> & population)
         continue;
       bool dominated = false;
       for (std::size_t k = 0; k < n && !dominated; ++k)
-        dominated = ranks[k] == n && morea::ConstraintDominates(population[k], population[i]);
+        dominated = ranks[k] == n && morea_core::ConstraintDominates(population[k], population[i]);
       if (!dominated)
         front.push_back(i);
     }
@@ -175,7 +175,7 @@ TEST(ParetoFront, RanksAreThoseOfPeelingFrontsOffOnPopulationsOfEveryShape)
   // Shapes the optimiser meets: scattered (many fronts), near one surface
   // (a large first front, as late in a run), exactly on it (one front),
   // coarse grids (ties and identical solutions) and infeasible ones.
-  morea::RandomGenerator random(11);
+  morea_core::RandomGenerator random(11);
   for (int shape = 0; shape < 5; ++shape)
     for (int round = 0; round < 4; ++round)
     {
@@ -202,7 +202,7 @@ TEST(ParetoFront, RanksAreThoseOfPeelingFrontsOffOnPopulationsOfEveryShape)
         }
         population.push_back(f);
       }
-      const auto ranks = morea::NonDominatedRanks(population);
+      const auto ranks = morea_core::NonDominatedRanks(population);
       ASSERT_EQ(ranks, RanksByPeeling(population)) << "shape " << shape << ", round " << round;
       if (shape == 2 && round == 0)
         EXPECT_EQ(*std::max_element(ranks.begin(), ranks.end()), 0u) << "all on one surface: one front";
@@ -217,60 +217,60 @@ TEST(ParetoFront, RanksCountANotANumberAsTheWorst)
   // NaN in any objective: worse than the same solution with a number there.
   const std::vector<Fitness> population{ Feasible(nan, 1.0, 1.0), Feasible(1.0, 1.0, 1.0), Feasible(0.0, nan, 0.0),
                                          Feasible(0.0, 2.0, 0.0) };
-  EXPECT_EQ(morea::NonDominatedRanks(population), (std::vector<std::size_t>{ 1, 0, 1, 0 }));
+  EXPECT_EQ(morea_core::NonDominatedRanks(population), (std::vector<std::size_t>{ 1, 0, 1, 0 }));
 }
 
 TEST(ParetoFront, HypervolumeOfHandComputedSets)
 {
   const ObjectiveVector reference{ { 4, 4, 4 } };
-  EXPECT_EQ(morea::Hypervolume({}, reference), 0.0);
+  EXPECT_EQ(morea_core::Hypervolume({}, reference), 0.0);
   // One box: 3 * 2 * 1.
-  EXPECT_DOUBLE_EQ(morea::Hypervolume({ { { 1, 2, 3 } } }, reference), 6.0);
+  EXPECT_DOUBLE_EQ(morea_core::Hypervolume({ { { 1, 2, 3 } } }, reference), 6.0);
   // Two overlapping boxes: 6 + 6 - overlap [2,4]x[2,4]x[3,4] = 4 -> 8.
-  EXPECT_DOUBLE_EQ(morea::Hypervolume({ { { 1, 2, 3 } }, { { 2, 1, 3 } } }, reference), 8.0);
+  EXPECT_DOUBLE_EQ(morea_core::Hypervolume({ { { 1, 2, 3 } }, { { 2, 1, 3 } } }, reference), 8.0);
   // A third box [3,4]x[3,4]x[1,4] = 3, of which [3,4]^3 = 1 is covered -> 10.
   const std::vector<ObjectiveVector> three{ { { 1, 2, 3 } }, { { 2, 1, 3 } }, { { 3, 3, 1 } } };
-  EXPECT_DOUBLE_EQ(morea::Hypervolume(three, reference), 10.0);
+  EXPECT_DOUBLE_EQ(morea_core::Hypervolume(three, reference), 10.0);
   // Order does not matter; dominated points and duplicates add nothing.
   std::vector<ObjectiveVector> more{ three[2], { { 3, 3, 3 } }, three[0], three[1], three[0] };
-  EXPECT_DOUBLE_EQ(morea::Hypervolume(more, reference), 10.0);
+  EXPECT_DOUBLE_EQ(morea_core::Hypervolume(more, reference), 10.0);
   // Points not strictly better than the reference in every objective are ignored,
   // even where they would otherwise dominate the others.
   more.push_back({ { 5, 0, 0 } });
   more.push_back({ { 0, 4, 0 } });
   more.push_back({ { 0, 0, 4 } });
-  EXPECT_DOUBLE_EQ(morea::Hypervolume(more, reference), 10.0);
+  EXPECT_DOUBLE_EQ(morea_core::Hypervolume(more, reference), 10.0);
   // Negative coordinates and a shifted reference.
-  EXPECT_DOUBLE_EQ(morea::Hypervolume({ { { -1, -2, -3 } } }, { { 0, 0, 0 } }), 6.0);
+  EXPECT_DOUBLE_EQ(morea_core::Hypervolume({ { { -1, -2, -3 } } }, { { 0, 0, 0 } }), 6.0);
 }
 
 TEST(ParetoFront, BoundedHypervolumeCountsFrontsBeyondItsScales)
 {
   const ObjectiveVector scales{ { 2, 4, 8 } };
-  EXPECT_EQ(morea::BoundedHypervolume({}, scales), 0.0);
+  EXPECT_EQ(morea_core::BoundedHypervolume({}, scales), 0.0);
   // f = s maps to 1/2 in every objective: (1 - 1/2)^3.
-  EXPECT_DOUBLE_EQ(morea::BoundedHypervolume({ { { 2, 4, 8 } } }, scales), 0.125);
+  EXPECT_DOUBLE_EQ(morea_core::BoundedHypervolume({ { { 2, 4, 8 } } }, scales), 0.125);
   // The origin dominates the whole unit cube.
-  EXPECT_DOUBLE_EQ(morea::BoundedHypervolume({ { { 0, 0, 0 } } }, scales), 1.0);
+  EXPECT_DOUBLE_EQ(morea_core::BoundedHypervolume({ { { 0, 0, 0 } } }, scales), 1.0);
   // f = 3 s maps to 3/4: a point far beyond the scales still counts, where a
   // box at the scales would have left it out.
-  EXPECT_DOUBLE_EQ(morea::BoundedHypervolume({ { { 6, 4, 8 } } }, scales), 0.25 * 0.5 * 0.5);
-  EXPECT_EQ(morea::Hypervolume({ { { 6, 4, 8 } } }, scales), 0.0);
+  EXPECT_DOUBLE_EQ(morea_core::BoundedHypervolume({ { { 6, 4, 8 } } }, scales), 0.25 * 0.5 * 0.5);
+  EXPECT_EQ(morea_core::Hypervolume({ { { 6, 4, 8 } } }, scales), 0.0);
   // Dominance is kept: a dominated point adds nothing, a better one adds.
   const std::vector<ObjectiveVector> two{ { { 2, 4, 8 } }, { { 6, 1, 8 } } };
-  const double                       volume = morea::BoundedHypervolume(two, scales);
+  const double                       volume = morea_core::BoundedHypervolume(two, scales);
   EXPECT_DOUBLE_EQ(volume, 0.125 + 0.25 * (0.8 - 0.5) * 0.5);
-  EXPECT_DOUBLE_EQ(morea::BoundedHypervolume({ two[0], two[1], { { 6, 4, 8 } } }, scales), volume);
-  EXPECT_GT(morea::BoundedHypervolume({ two[0], two[1], { { 1, 4, 8 } } }, scales), volume);
+  EXPECT_DOUBLE_EQ(morea_core::BoundedHypervolume({ two[0], two[1], { { 6, 4, 8 } } }, scales), volume);
+  EXPECT_GT(morea_core::BoundedHypervolume({ two[0], two[1], { { 1, 4, 8 } } }, scales), volume);
   // Infinite objectives count for nothing; bad scales are an error.
-  EXPECT_EQ(morea::BoundedHypervolume({ { { 2, INFINITY, 8 } } }, scales), 0.0);
-  EXPECT_THROW(morea::BoundedHypervolume({}, { { 1, 0, 1 } }), morea::Error);
-  EXPECT_THROW(morea::BoundedHypervolume({}, { { 1, NAN, 1 } }), morea::Error);
+  EXPECT_EQ(morea_core::BoundedHypervolume({ { { 2, INFINITY, 8 } } }, scales), 0.0);
+  EXPECT_THROW(morea_core::BoundedHypervolume({}, { { 1, 0, 1 } }), morea_core::Error);
+  EXPECT_THROW(morea_core::BoundedHypervolume({}, { { 1, NAN, 1 } }), morea_core::Error);
 }
 
 TEST(ParetoFront, HypervolumeMatchesBruteForceOnRandomSets)
 {
-  morea::RandomGenerator random(11);
+  morea_core::RandomGenerator random(11);
   const ObjectiveVector  reference{ { 1.0, 1.2, 0.9 } };
   for (int trial = 0; trial < 40; ++trial)
   {
@@ -296,7 +296,7 @@ TEST(ParetoFront, HypervolumeMatchesBruteForceOnRandomSets)
       points.push_back(p);
     }
     const double exact = GridHypervolume(points, reference);
-    EXPECT_NEAR(morea::Hypervolume(points, reference), exact, 1e-12 * std::max(1.0, exact)) << "trial " << trial;
+    EXPECT_NEAR(morea_core::Hypervolume(points, reference), exact, 1e-12 * std::max(1.0, exact)) << "trial " << trial;
   }
 }
 
@@ -304,7 +304,7 @@ TEST(ParetoFront, HypervolumeOf2000PointsIsFast)
 {
   // 2000 points on the unit sphere's positive octant, all non-dominated. Their
   // boxes lie outside the ball, so the volume is below 1 - pi/6 and near it.
-  morea::RandomGenerator       random(3);
+  morea_core::RandomGenerator       random(3);
   std::vector<ObjectiveVector> points;
   while (points.size() < 2000)
   {
@@ -317,7 +317,7 @@ TEST(ParetoFront, HypervolumeOf2000PointsIsFast)
     points.push_back(p);
   }
   const auto   start = std::chrono::steady_clock::now();
-  const double volume = morea::Hypervolume(points, { { 1, 1, 1 } });
+  const double volume = morea_core::Hypervolume(points, { { 1, 1, 1 } });
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   std::printf("Hypervolume of %zu points: %.3f ms\n", points.size(), ms);
   EXPECT_LT(ms, 50.0);
@@ -331,9 +331,9 @@ TEST(ParetoFront, SelectBestGuidance)
   // Guidance 2 twice: index 1 has the smaller normalised sum (1/3 + 1/5 + 0
   // against 0 + 1 + 0).
   const std::vector<ObjectiveVector> front{ { { 0, 0, 5 } }, { { 1, 1, 2 } }, { { 0, 5, 2 } }, { { 3, 3, 9 } } };
-  EXPECT_EQ(morea::SelectBestGuidance(front), 1u);
-  EXPECT_EQ(morea::SelectBestGuidance({ { { 7, 7, 7 } } }), 0u);
-  EXPECT_THROW(morea::SelectBestGuidance({}), morea::Error);
+  EXPECT_EQ(morea_core::SelectBestGuidance(front), 1u);
+  EXPECT_EQ(morea_core::SelectBestGuidance({ { { 7, 7, 7 } } }), 0u);
+  EXPECT_THROW(morea_core::SelectBestGuidance({}), morea_core::Error);
 }
 
 TEST(ParetoFront, SelectKnee)
@@ -341,48 +341,48 @@ TEST(ParetoFront, SelectKnee)
   // Extremes on the plane x + y + z = 1; (0.2, 0.2, 0.2) lies farthest below it.
   std::vector<ObjectiveVector> front{ { { 1, 0, 0 } },       { { 0.3, 0.3, 0.1 } }, { { 0, 1, 0 } },
                                       { { 0.2, 0.2, 0.2 } }, { { 0, 0, 1 } },       { { 0.1, 0.1, 0.9 } } };
-  EXPECT_EQ(morea::SelectKnee(front), 3u);
+  EXPECT_EQ(morea_core::SelectKnee(front), 3u);
   // Normalisation: rescaling and shifting objectives changes nothing.
   for (auto & p : front)
     p = { { 100.0 * p[0] + 5.0, p[1] - 2.0, 0.01 * p[2] } };
-  EXPECT_EQ(morea::SelectKnee(front), 3u);
+  EXPECT_EQ(morea_core::SelectKnee(front), 3u);
 
   // A front flat in one objective has two extremes: the one nearest the ideal
   // point is (0.25, 0.25) normalised.
-  EXPECT_EQ(morea::SelectKnee({ { { 0, 4, 1 } }, { { 4, 0, 1 } }, { { 1, 1, 1 } }, { { 3, 0.5, 1 } } }), 2u);
-  EXPECT_EQ(morea::SelectKnee({ { { 1, 2, 3 } } }), 0u);
-  EXPECT_THROW(morea::SelectKnee({}), morea::Error);
+  EXPECT_EQ(morea_core::SelectKnee({ { { 0, 4, 1 } }, { { 4, 0, 1 } }, { { 1, 1, 1 } }, { { 3, 0.5, 1 } } }), 2u);
+  EXPECT_EQ(morea_core::SelectKnee({ { { 1, 2, 3 } } }), 0u);
+  EXPECT_THROW(morea_core::SelectKnee({}), morea_core::Error);
 }
 
 TEST(ParetoFront, SelectWeighted)
 {
   const std::vector<ObjectiveVector> front{ { { 0, 10, 10 } }, { { 10, 0, 10 } }, { { 10, 10, 0 } }, { { 4, 4, 4 } } };
-  EXPECT_EQ(morea::SelectWeighted(front, { { 1, 0, 0 } }), 0u);
-  EXPECT_EQ(morea::SelectWeighted(front, { { 0, 0, 2 } }), 2u);
-  EXPECT_EQ(morea::SelectWeighted(front, { { 1, 1, 1 } }), 3u); // 1.2 against 2
-  EXPECT_EQ(morea::SelectWeighted(front, { { 0, 3, 1 } }), 1u); // 1 against 1.6
+  EXPECT_EQ(morea_core::SelectWeighted(front, { { 1, 0, 0 } }), 0u);
+  EXPECT_EQ(morea_core::SelectWeighted(front, { { 0, 0, 2 } }), 2u);
+  EXPECT_EQ(morea_core::SelectWeighted(front, { { 1, 1, 1 } }), 3u); // 1.2 against 2
+  EXPECT_EQ(morea_core::SelectWeighted(front, { { 0, 3, 1 } }), 1u); // 1 against 1.6
   // Weights act on normalised objectives: objective 0 in large units does not
   // swamp the others.
   const std::vector<ObjectiveVector> scaled{ { { 0, 1, 1 } }, { { 1000, 0, 0.6 } } };
-  EXPECT_EQ(morea::SelectWeighted(scaled, { { 1, 1, 1 } }), 1u); // 1 against 2
+  EXPECT_EQ(morea_core::SelectWeighted(scaled, { { 1, 1, 1 } }), 1u); // 1 against 2
 
-  EXPECT_THROW(morea::SelectWeighted(front, { { 0, 0, 0 } }), morea::Error);
-  EXPECT_THROW(morea::SelectWeighted(front, { { 1, -1, 1 } }), morea::Error);
-  EXPECT_THROW(morea::SelectWeighted(front, { { 1, std::numeric_limits<double>::quiet_NaN(), 1 } }), morea::Error);
-  EXPECT_THROW(morea::SelectWeighted(front, { { 1, std::numeric_limits<double>::infinity(), 1 } }), morea::Error);
-  EXPECT_THROW(morea::SelectWeighted({}, { { 1, 1, 1 } }), morea::Error);
+  EXPECT_THROW(morea_core::SelectWeighted(front, { { 0, 0, 0 } }), morea_core::Error);
+  EXPECT_THROW(morea_core::SelectWeighted(front, { { 1, -1, 1 } }), morea_core::Error);
+  EXPECT_THROW(morea_core::SelectWeighted(front, { { 1, std::numeric_limits<double>::quiet_NaN(), 1 } }), morea_core::Error);
+  EXPECT_THROW(morea_core::SelectWeighted(front, { { 1, std::numeric_limits<double>::infinity(), 1 } }), morea_core::Error);
+  EXPECT_THROW(morea_core::SelectWeighted({}, { { 1, 1, 1 } }), morea_core::Error);
 }
 
 TEST(ParetoFront, SelectNearest)
 {
   const std::vector<ObjectiveVector> front{ { { 0, 10, 10 } }, { { 10, 0, 10 } }, { { 10, 10, 0 } }, { { 4, 4, 4 } } };
-  EXPECT_EQ(morea::SelectNearest(front, { { 10, 0, 10 } }), 1u);
-  EXPECT_EQ(morea::SelectNearest(front, { { 5, 5, 5 } }), 3u);
-  EXPECT_EQ(morea::SelectNearest(front, { { 9, 8, -3 } }), 2u);
+  EXPECT_EQ(morea_core::SelectNearest(front, { { 10, 0, 10 } }), 1u);
+  EXPECT_EQ(morea_core::SelectNearest(front, { { 5, 5, 5 } }), 3u);
+  EXPECT_EQ(morea_core::SelectNearest(front, { { 9, 8, -3 } }), 2u);
   // Distances are taken after normalising: (60, 1, 0) is (0.6, 1, 0), nearer
   // (0, 1, 0) than (1, 0, 0), though in raw units it is nearer (100, 0, 0).
   const std::vector<ObjectiveVector> scaled{ { { 0, 1, 0 } }, { { 100, 0, 0 } } };
-  EXPECT_EQ(morea::SelectNearest(scaled, { { 60, 1, 0 } }), 0u);
-  EXPECT_EQ(morea::SelectNearest(scaled, { { 80, 0.2, 0 } }), 1u);
-  EXPECT_THROW(morea::SelectNearest({}, { { 0, 0, 0 } }), morea::Error);
+  EXPECT_EQ(morea_core::SelectNearest(scaled, { { 60, 1, 0 } }), 0u);
+  EXPECT_EQ(morea_core::SelectNearest(scaled, { { 80, 0.2, 0 } }), 1u);
+  EXPECT_THROW(morea_core::SelectNearest({}, { { 0, 0, 0 } }), morea_core::Error);
 }

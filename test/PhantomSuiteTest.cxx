@@ -4,9 +4,9 @@
 // documented volumes and displacements, bones that do not move, content in
 // one image only, landmarks of every kind, and a truth that is consistent:
 // an invertible mapping whose fields, masks and landmarks agree with it.
-#include "morea/Error.h"
-#include "morea/Phantom.h"
-#include "morea/Random.h"
+#include "morea_core/Error.h"
+#include "morea_core/Phantom.h"
+#include "morea_core/Random.h"
 
 #include <gtest/gtest.h>
 
@@ -17,9 +17,9 @@
 
 namespace
 {
-using morea::PelvisPhantom;
-using morea::PhantomOptions;
-using morea::Vec3;
+using morea_core::PelvisPhantom;
+using morea_core::PhantomOptions;
+using morea_core::Vec3;
 
 enum Structure : std::size_t
 {
@@ -59,7 +59,7 @@ SharedCase(const std::string & name)
 }
 
 std::size_t
-Voxels(const morea::Volume<std::uint8_t> & mask)
+Voxels(const morea_core::Volume<std::uint8_t> & mask)
 {
   return static_cast<std::size_t>(std::count_if(mask.data.begin(), mask.data.end(), [](std::uint8_t v) { return v != 0; }));
 }
@@ -98,15 +98,15 @@ TEST(PhantomSuite, CasesAreNamedAndCheckedLikeThePelvis)
     EXPECT_EQ(o.translation, (Vec3{ { 0.0, 0.0, 0.0 } })) << name;
     EXPECT_EQ(o.rotationDegrees, (Vec3{ { 0.0, 0.0, 0.0 } })) << name;
   }
-  EXPECT_THROW(PhantomOptions::OfCase("knee"), morea::Error);
+  EXPECT_THROW(PhantomOptions::OfCase("knee"), morea_core::Error);
   PhantomOptions bad = PhantomOptions::OfCase("bladder-emptying");
   bad.bladderGrowth = 1.2; // emptying grows nothing
-  EXPECT_THROW(PelvisPhantom{ bad }, morea::Error);
+  EXPECT_THROW(PelvisPhantom{ bad }, morea_core::Error);
   bad = PhantomOptions::OfCase("static-bones");
   bad.bladderGrowth = 2.2; // beyond what its reach keeps monotone
-  EXPECT_THROW(PelvisPhantom{ bad }, morea::Error);
+  EXPECT_THROW(PelvisPhantom{ bad }, morea_core::Error);
   bad.caseName = "knee";
-  EXPECT_THROW(PelvisPhantom{ bad }, morea::Error);
+  EXPECT_THROW(PelvisPhantom{ bad }, morea_core::Error);
 }
 
 TEST(PhantomSuite, EveryCaseIsADiffeomorphismWithAnExactInverse)
@@ -114,7 +114,7 @@ TEST(PhantomSuite, EveryCaseIsADiffeomorphismWithAnExactInverse)
   for (const std::string & name : kSuiteCases)
   {
     const PelvisPhantom    phantom(PhantomOptions::OfCase(name));
-    morea::RandomGenerator g(7);
+    morea_core::RandomGenerator g(7);
     double                 worst = 0.0, smallestDeterminant = 1e300;
     const Vec3 &           c = phantom.DeformationCentre();
     const Vec3 &           a = phantom.DeformationAxes();

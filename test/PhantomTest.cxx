@@ -1,10 +1,10 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-// Tests of morea::PelvisPhantom: the analytic deformation and the generated case.
+// Tests of morea_core::PelvisPhantom: the analytic deformation and the generated case.
 // Core tests: no ITK headers here.
-#include "morea/Error.h"
-#include "morea/Phantom.h"
-#include "morea/Random.h"
+#include "morea_core/Error.h"
+#include "morea_core/Phantom.h"
+#include "morea_core/Random.h"
 
 #include <gtest/gtest.h>
 
@@ -16,9 +16,9 @@
 
 namespace
 {
-using morea::PelvisPhantom;
-using morea::PhantomOptions;
-using morea::Vec3;
+using morea_core::PelvisPhantom;
+using morea_core::PhantomOptions;
+using morea_core::Vec3;
 
 constexpr double kPi = 3.14159265358979323846;
 
@@ -42,7 +42,7 @@ Distance(const Vec3 & a, const Vec3 & b)
 }
 
 Vec3
-RandomPoint(morea::RandomGenerator & g)
+RandomPoint(morea_core::RandomGenerator & g)
 {
   return { g.Uniform(kLo[0], kHi[0]), g.Uniform(kLo[1], kHi[1]), g.Uniform(kLo[2], kHi[2]) };
 }
@@ -84,7 +84,7 @@ SharedCase()
 }
 
 std::size_t
-CountOn(const morea::Volume<std::uint8_t> & mask)
+CountOn(const morea_core::Volume<std::uint8_t> & mask)
 {
   std::size_t n = 0;
   for (auto v : mask.data)
@@ -100,7 +100,7 @@ CountOn(const morea::Volume<std::uint8_t> & mask)
 TEST(Phantom, InverseUndoesTheForwardMappingEverywhere)
 {
   const PelvisPhantom    phantom;
-  morea::RandomGenerator g(5);
+  morea_core::RandomGenerator g(5);
   double                 worst = 0.0;
   for (int n = 0; n < 20000; ++n)
   {
@@ -124,7 +124,7 @@ TEST(Phantom, InverseIsExactForTheLargestAllowedGrowth)
   PhantomOptions o;
   o.bladderGrowth = 2.35;
   const PelvisPhantom    phantom(o);
-  morea::RandomGenerator g(6);
+  morea_core::RandomGenerator g(6);
   for (int n = 0; n < 5000; ++n)
   {
     const Vec3 x = RandomPoint(g);
@@ -139,7 +139,7 @@ TEST(Phantom, DeformationIsADiffeomorphism)
     PhantomOptions o;
     o.bladderGrowth = growth;
     const PelvisPhantom    phantom(o);
-    morea::RandomGenerator g(7);
+    morea_core::RandomGenerator g(7);
     double                 smallest = std::numeric_limits<double>::infinity();
     for (int n = 0; n < 20000; ++n)
     {
@@ -197,7 +197,7 @@ TEST(Phantom, RigidPartFollowsTheDocumentedConvention)
   o.translation = { { 4.0, -7.0, 12.0 } };
   {
     const PelvisPhantom    phantom(o);
-    morea::RandomGenerator g(8);
+    morea_core::RandomGenerator g(8);
     for (int n = 0; n < 100; ++n)
     {
       const Vec3 x = RandomPoint(g);
@@ -210,7 +210,7 @@ TEST(Phantom, RigidPartFollowsTheDocumentedConvention)
   PhantomOptions rigid;
   rigid.bladderGrowth = 1.0;
   const PelvisPhantom    phantom(rigid);
-  morea::RandomGenerator g(9);
+  morea_core::RandomGenerator g(9);
   for (int n = 0; n < 100; ++n)
   {
     const Vec3 a = RandomPoint(g), b = RandomPoint(g);
@@ -259,7 +259,7 @@ TEST(Phantom, StructureMembershipAndHounsfieldValues)
   EXPECT_LE(boneB, 800.0);
   EXPECT_GT(std::abs(boneA - boneB), 1.0);
   EXPECT_DOUBLE_EQ(phantom.HounsfieldAt({ { 0.0, -25.0, -15.0 } }), 5.0);   // urine
-  EXPECT_THROW(phantom.InStructure(5, { { 0.0, 0.0, 0.0 } }), morea::Error);
+  EXPECT_THROW(phantom.InStructure(5, { { 0.0, 0.0, 0.0 } }), morea_core::Error);
 }
 
 TEST(Phantom, InvalidOptionsThrow)
@@ -269,20 +269,20 @@ TEST(Phantom, InvalidOptionsThrow)
   {
     PhantomOptions o;
     o.spacing = spacing;
-    EXPECT_THROW(PelvisPhantom{ o }, morea::Error) << "spacing " << spacing;
+    EXPECT_THROW(PelvisPhantom{ o }, morea_core::Error) << "spacing " << spacing;
   }
   // Above about 2.4 the radial profile is no longer monotonic and T folds.
   for (double growth : { 0.99, 0.0, 2.4, 2.5, nan })
   {
     PhantomOptions o;
     o.bladderGrowth = growth;
-    EXPECT_THROW(PelvisPhantom{ o }, morea::Error) << "growth " << growth;
+    EXPECT_THROW(PelvisPhantom{ o }, morea_core::Error) << "growth " << growth;
   }
   for (double noise : { -1.0, nan })
   {
     PhantomOptions o;
     o.noiseSigma = noise;
-    EXPECT_THROW(PelvisPhantom{ o }, morea::Error) << "noise " << noise;
+    EXPECT_THROW(PelvisPhantom{ o }, morea_core::Error) << "noise " << noise;
   }
   // The limits themselves are valid.
   PhantomOptions o;

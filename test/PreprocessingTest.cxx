@@ -149,9 +149,9 @@ TEST(Preprocessing, SurfacePointsOfACubeAreItsOuterShell)
 
 TEST(Preprocessing, PhantomIsAlignedCroppedAndWindowed)
 {
-  ::morea::PhantomOptions options;
+  morea_core::PhantomOptions options;
   options.spacing = 2.0;
-  const ::morea::PelvisPhantom phantom(options);
+  const morea_core::PelvisPhantom phantom(options);
   const auto                   problem = MakePhantomProblem(phantom.Generate());
   EXPECT_EQ(LargestDeformingStructure(problem), "bladder");
 
@@ -252,9 +252,9 @@ StoredOtherwise(const TImage * image)
 
 TEST(Preprocessing, HowTheAxesAreStoredDoesNotChangeTheResult)
 {
-  ::morea::PhantomOptions options;
+  morea_core::PhantomOptions options;
   options.spacing = 4.0;
-  const auto problem = MakePhantomProblem(::morea::PelvisPhantom(options).Generate());
+  const auto problem = MakePhantomProblem(morea_core::PelvisPhantom(options).Generate());
   auto       other = problem;
   other.fixedImage = StoredOtherwise(problem.fixedImage.GetPointer());
   other.movingImage = StoredOtherwise(problem.movingImage.GetPointer());
@@ -283,9 +283,9 @@ TEST(Preprocessing, HowTheAxesAreStoredDoesNotChangeTheResult)
 
 TEST(Preprocessing, UnknownStructuresAndBadOptionsAreErrors)
 {
-  ::morea::PhantomOptions options;
+  morea_core::PhantomOptions options;
   options.spacing = 5.0;
-  const auto problem = MakePhantomProblem(::morea::PelvisPhantom(options).Generate());
+  const auto problem = MakePhantomProblem(morea_core::PelvisPhantom(options).Generate());
   PreprocessOptions pre;
   // Errors name the parameter key that named the structure.
   const auto messageOf = [&](const PreprocessOptions & o) {
@@ -312,9 +312,9 @@ TEST(Preprocessing, UnknownStructuresAndBadOptionsAreErrors)
 
 TEST(Preprocessing, AnAbsurdSpacingIsRefusedWithTheFigures)
 {
-  ::morea::PhantomOptions options;
+  morea_core::PhantomOptions options;
   options.spacing = 5.0;
-  auto problem = MakePhantomProblem(::morea::PelvisPhantom(options).Generate());
+  auto problem = MakePhantomProblem(morea_core::PelvisPhantom(options).Generate());
   // A header in metres read as millimetres, a thousandfold: the grid would be astronomically large.
   auto huge = problem.fixedImage->GetSpacing();
   huge.Fill(5000.0);

@@ -7,7 +7,7 @@
 #include "itkMOREAImageIO.h"
 #include "itkPreprocessing.h"
 #include "itkRegistrationProblem.h"
-#include "morea/ParameterSet.h"
+#include "morea_core/ParameterSet.h"
 
 #include "ItkErrorSupport.h"
 #include "TestScratchDir.h"
@@ -90,7 +90,7 @@ TEST(ProblemValidation, AGuidanceStructureThatVanishesInPreprocessingIsRefused)
   EXPECT_EQ(result.report.droppedReasons[0],
             "its fixed and moving masks have no voxel inside the crop to 'organ' with a margin of 2 mm");
 
-  ::morea::ParameterSet parameters; // problem_guidance_selection = -1: every structure guides
+  morea_core::ParameterSet parameters; // problem_guidance_selection = -1: every structure guides
   EXPECT_EQ(ItkError([&] { CheckGuidanceStructuresKept(result.report, parameters); }),
             "ITK ERROR: structure 'corner' vanished in preprocessing: its fixed and moving masks have no voxel inside the crop to "
             "'organ' with a margin of 2 mm, so the registration would run without it; crop to a region that holds it "

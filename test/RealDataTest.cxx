@@ -5,9 +5,9 @@
 #include "itkMeshModel.h"
 #include "itkPreprocessing.h"
 #include "itkRegistrationEvaluation.h"
-#include "morea/FoldConstraint.h"
-#include "morea/InitialPopulation.h"
-#include "morea/ParameterSet.h"
+#include "morea_core/FoldConstraint.h"
+#include "morea_core/InitialPopulation.h"
+#include "morea_core/ParameterSet.h"
 
 #include <gtest/gtest.h>
 
@@ -48,7 +48,7 @@ TEST(RealData, LungPairRigidPreAlignmentOnLungMasksBringsTreUnderFiveMillimetres
   EXPECT_GT(after.structures.at(0).dice, 0.85);
 
   // The 600-point mesh model with the lung surface as a constraint.
-  ::morea::ParameterSet parameters;
+  morea_core::ParameterSet parameters;
   parameters.SetFromString("morea_mesh_surface_structures", "lungs");
   const MeshModel model = BuildMeshModel(result.problem, parameters);
   const auto &    g = model.report.generation;
@@ -58,8 +58,8 @@ TEST(RealData, LungPairRigidPreAlignmentOnLungMasksBringsTreUnderFiveMillimetres
   EXPECT_GT(g.surfacePoints, 300u);
   EXPECT_FALSE(model.base.constrainedFaces.empty());
   EXPECT_GE(model.report.parallelGroups, 2u);
-  const ::morea::FoldConstraint constraint(model.topology, model.base.points);
-  for (const auto & s : ::morea::GenerateInitialPopulation(model.base, constraint, 20, 1))
+  const morea_core::FoldConstraint constraint(model.topology, model.base.points);
+  for (const auto & s : morea_core::GenerateInitialPopulation(model.base, constraint, 20, 1))
     EXPECT_TRUE(constraint.Evaluate(s).Feasible());
   std::cout << "lung mesh: " << model.base.NumberOfPoints() << " points (" << g.surfacePoints << " on the lung surface, "
             << g.surfaceTriangles << " constraining triangles, " << g.steinerPoints << " Steiner), "

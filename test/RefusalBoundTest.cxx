@@ -4,15 +4,15 @@
 // refused before their samples are drawn, and steering.
 #include "OptimiserTestProblem.h"
 
-#include "morea/Error.h"
-#include "morea/RefusalBound.h"
+#include "morea_core/Error.h"
+#include "morea_core/RefusalBound.h"
 
 #include <gtest/gtest.h>
 
 #include <atomic>
 #include <limits>
 
-using namespace morea;
+using namespace morea_core;
 using morea_test::OptimiserTestProblem;
 
 namespace

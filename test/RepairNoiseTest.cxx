@@ -3,7 +3,7 @@
 // The fold repair's moves (RepairNoise.h): the hand-written logarithm and
 // sine/cosine match the C library to double precision, and the normals are
 // standard normal and a pure function of their key.
-#include "morea/RepairNoise.h"
+#include "morea_core/RepairNoise.h"
 
 #include <gtest/gtest.h>
 
@@ -11,7 +11,7 @@
 #include <cmath>
 #include <set>
 
-using namespace morea;
+using namespace morea_core;
 
 TEST(RepairNoise, LogarithmMatchesTheLibrary)
 {

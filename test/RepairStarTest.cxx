@@ -4,8 +4,8 @@
 // oriented volume as an affine function of one corner, for each place of the
 // corner and either orientation of the base volume, and violations that fold
 // exactly where the constraint does.
-#include "morea/RepairStar.h"
-#include "morea/TetrahedralMesh.h"
+#include "morea_core/RepairStar.h"
+#include "morea_core/TetrahedralMesh.h"
 
 #include <gtest/gtest.h>
 
@@ -13,7 +13,7 @@
 #include <cmath>
 #include <random>
 
-using namespace morea;
+using namespace morea_core;
 
 namespace
 {

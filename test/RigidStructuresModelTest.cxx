@@ -5,8 +5,8 @@
 // exactly the tetrahedra overlapping their masks get the rigidity term.
 #include "itkMeshModel.h"
 #include "itkPhantomImages.h"
-#include "morea/ElasticityFactors.h"
-#include "morea/ParameterSet.h"
+#include "morea_core/ElasticityFactors.h"
+#include "morea_core/ParameterSet.h"
 
 #include <gtest/gtest.h>
 
@@ -20,9 +20,9 @@ const RegistrationProblem &
 Phantom()
 {
   static const RegistrationProblem problem = [] {
-    ::morea::PhantomOptions options;
+    morea_core::PhantomOptions options;
     options.spacing = 6.0;
-    return MakePhantomProblem(::morea::PelvisPhantom(options).Generate());
+    return MakePhantomProblem(morea_core::PelvisPhantom(options).Generate());
   }();
   return problem;
 }
@@ -30,7 +30,7 @@ Phantom()
 MeshModel
 Model(const std::vector<std::pair<std::string, std::string>> & settings)
 {
-  ::morea::ParameterSet parameters;
+  morea_core::ParameterSet parameters;
   parameters.SetFromString("morea_mesh_num_points", "80");
   for (const auto & [key, value] : settings)
     parameters.SetFromString(key, value);
@@ -54,7 +54,7 @@ TEST(RigidStructuresModel, BonesAreRigidByDefaultGuidanceOrNot)
   ASSERT_FALSE(model.rigidity.Empty());
   // The rigid tetrahedra are those overlapping the bones' moving mask.
   const auto bones = ToVolume(Phantom().GetStructure("bones").movingMask.GetPointer(), model.frame);
-  const auto fractions = ::morea::UnionOverlapFractions(model.base, { &bones });
+  const auto fractions = morea_core::UnionOverlapFractions(model.base, { &bones });
   for (std::size_t t = 0; t < fractions.size(); ++t)
     EXPECT_EQ(model.rigidity.weights[t] > 0.0, fractions[t] > 0.0) << t;
   EXPECT_GT(RigidTetrahedra(model), 0u);

@@ -5,16 +5,16 @@
 // mesh moves; and the choice of rigid structures by name.
 #include "BoxMesh.h"
 
-#include "morea/Error.h"
-#include "morea/ParameterSet.h"
-#include "morea/RigidityTerm.h"
-#include "morea/RunFingerprint.h"
+#include "morea_core/Error.h"
+#include "morea_core/ParameterSet.h"
+#include "morea_core/RigidityTerm.h"
+#include "morea_core/RunFingerprint.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-using namespace morea;
+using namespace morea_core;
 using morea_test::MakeBoxMesh;
 
 namespace

@@ -2,10 +2,10 @@
 // SPDX-License-Identifier: Apache-2.0
 // Tests of the order in which the CUDA texture path's warps take a
 // tetrahedron's Sobol samples (morea/SampleCosets.h).
-#include "morea/SampleCosets.h"
+#include "morea_core/SampleCosets.h"
 
-#include "morea/Error.h"
-#include "morea/TetrahedronSampling.h"
+#include "morea_core/Error.h"
+#include "morea_core/TetrahedronSampling.h"
 
 #include <gtest/gtest.h>
 
@@ -16,7 +16,7 @@
 
 namespace
 {
-using namespace morea;
+using namespace morea_core;
 
 TEST(SampleCosets, BlocksFollowTheBinaryDigitsOfTheWholeChunks)
 {

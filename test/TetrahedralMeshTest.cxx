@@ -4,12 +4,12 @@
 // the generated phantom mesh.
 #include "MeshTestSupport.h"
 
-#include "morea/Error.h"
-#include "morea/MeshGenerator.h"
-#include "morea/MeshPointPlacement.h"
-#include "morea/ParameterSet.h"
-#include "morea/StructureSurface.h"
-#include "morea/Tetrahedralization.h"
+#include "morea_core/Error.h"
+#include "morea_core/MeshGenerator.h"
+#include "morea_core/MeshPointPlacement.h"
+#include "morea_core/ParameterSet.h"
+#include "morea_core/StructureSurface.h"
+#include "morea_core/Tetrahedralization.h"
 
 #include <gtest/gtest.h>
 
@@ -19,8 +19,8 @@
 
 namespace
 {
-using morea::Tetrahedron;
-using morea::Vec3;
+using morea_core::Tetrahedron;
+using morea_core::Vec3;
 
 double
 Distance(const Vec3 & a, const Vec3 & b)
@@ -31,33 +31,33 @@ Distance(const Vec3 & a, const Vec3 & b)
 TEST(TetrahedralMesh, SignedVolumeOfUnitCornerTetrahedron)
 {
   const Vec3 o{ { 0, 0, 0 } }, x{ { 2, 0, 0 } }, y{ { 0, 3, 0 } }, z{ { 0, 0, 4 } };
-  EXPECT_DOUBLE_EQ(morea::SignedVolume(o, x, y, z), 4.0);
-  EXPECT_DOUBLE_EQ(morea::SignedVolume(o, y, x, z), -4.0);
-  EXPECT_DOUBLE_EQ(morea::SignedVolume(o, x, x, z), 0.0);
+  EXPECT_DOUBLE_EQ(morea_core::SignedVolume(o, x, y, z), 4.0);
+  EXPECT_DOUBLE_EQ(morea_core::SignedVolume(o, y, x, z), -4.0);
+  EXPECT_DOUBLE_EQ(morea_core::SignedVolume(o, x, x, z), 0.0);
 }
 
 TEST(TetrahedralMesh, TopologyListsTetrahedraEdgesAndNeighbours)
 {
   // Two tetrahedra sharing the face (0,1,2).
   const std::vector<Tetrahedron> tets{ { { 0, 1, 2, 3 } }, { { 0, 2, 1, 4 } } };
-  const morea::MeshTopology      topology(tets, 5);
+  const morea_core::MeshTopology      topology(tets, 5);
   EXPECT_EQ(topology.NumberOfPoints(), 5u);
   EXPECT_EQ(topology.Edges().size(), 9u); // 3 shared + 3 + 3
   EXPECT_EQ(topology.TetrahedraOfPoint(0), (std::vector<std::uint32_t>{ 0, 1 }));
   EXPECT_EQ(topology.TetrahedraOfPoint(3), (std::vector<std::uint32_t>{ 0 }));
   EXPECT_EQ(topology.Neighbours(3), (std::vector<std::uint32_t>{ 0, 1, 2 }));
   EXPECT_EQ(topology.Neighbours(0), (std::vector<std::uint32_t>{ 1, 2, 3, 4 }));
-  EXPECT_THROW(morea::MeshTopology(tets, 4), morea::Error);
+  EXPECT_THROW(morea_core::MeshTopology(tets, 4), morea_core::Error);
 }
 
 TEST(TetrahedralMesh, PinsAndProjectionKeepPointsOnTheirFaces)
 {
-  morea::MeshDomain d;
+  morea_core::MeshDomain d;
   d.lower = { { 0, 0, 0 } };
   d.upper = { { 10, 20, 30 } };
-  EXPECT_EQ(morea::PinOf({ { 0, 5, 30 } }, d, 1e-9), (morea::BoundaryPin{ { -1, 0, 1 } }));
-  EXPECT_EQ(morea::PinOf({ { 5, 5, 5 } }, d, 1e-9), (morea::BoundaryPin{ { 0, 0, 0 } }));
-  const Vec3 q = morea::ProjectToDomain({ { 3, -4, 31 } }, { { -1, 0, 0 } }, d);
+  EXPECT_EQ(morea_core::PinOf({ { 0, 5, 30 } }, d, 1e-9), (morea_core::BoundaryPin{ { -1, 0, 1 } }));
+  EXPECT_EQ(morea_core::PinOf({ { 5, 5, 5 } }, d, 1e-9), (morea_core::BoundaryPin{ { 0, 0, 0 } }));
+  const Vec3 q = morea_core::ProjectToDomain({ { 3, -4, 31 } }, { { -1, 0, 0 } }, d);
   EXPECT_EQ(q, (Vec3{ { 0, 0, 30 } }));
 }
 
@@ -68,54 +68,54 @@ TEST(MeshPointPlacement, SpreadOutSubsetPicksFarthestPoints)
   std::vector<Vec3> line;
   for (int i = 0; i <= 100; ++i)
     line.push_back({ { double(i), 0, 0 } });
-  const auto chosen = morea::SpreadOutSubset(line, 3, { { { 0, 0, 0 } } }, 0.0);
+  const auto chosen = morea_core::SpreadOutSubset(line, 3, { { { 0, 0, 0 } } }, 0.0);
   ASSERT_EQ(chosen.size(), 3u);
   EXPECT_EQ(chosen[0][0], 100.0);
   EXPECT_EQ(chosen[1][0], 50.0);
   EXPECT_TRUE(chosen[2][0] == 25.0 || chosen[2][0] == 75.0);
   // The minimum distance stops the selection instead of placing near-duplicates.
   const std::vector<Vec3> two{ { { 0, 0, 0 } }, { { 0.1, 0, 0 } } };
-  EXPECT_EQ(morea::SpreadOutSubset(two, 2, { { { 50, 0, 0 } } }, 1.0).size(), 1u);
+  EXPECT_EQ(morea_core::SpreadOutSubset(two, 2, { { { 50, 0, 0 } } }, 1.0).size(), 1u);
 }
 
 TEST(MeshPointPlacement, MaskBoundaryPointsOfACube)
 {
-  morea::Volume<std::uint8_t> mask({ { 5, 5, 5 } }, { { 1, 1, 1 } }, { { 0, 0, 0 } });
+  morea_core::Volume<std::uint8_t> mask({ { 5, 5, 5 } }, { { 1, 1, 1 } }, { { 0, 0, 0 } });
   for (std::size_t k = 1; k < 4; ++k)
     for (std::size_t j = 1; j < 4; ++j)
       for (std::size_t i = 1; i < 4; ++i)
         mask(i, j, k) = 1;
-  EXPECT_EQ(morea::MaskBoundaryPoints(mask).size(), 26u); // 27 voxels minus the centre
+  EXPECT_EQ(morea_core::MaskBoundaryPoints(mask).size(), 26u); // 27 voxels minus the centre
 }
 
 TEST(Tetrahedralization, DelaunayOfACubeTilesIt)
 {
-  morea::MeshDomain d;
+  morea_core::MeshDomain d;
   d.upper = { { 2, 3, 4 } };
-  auto points = morea::DomainCorners(d);
+  auto points = morea_core::DomainCorners(d);
   points.push_back({ { 1, 1.5, 2 } });
-  const auto result = morea::Tetrahedralize(points);
+  const auto result = morea_core::Tetrahedralize(points);
   EXPECT_EQ(result.steinerPoints, 0u);
   double volume = 0.0;
   for (const auto & t : result.tetrahedra)
   {
-    const double v = morea::SignedVolume(t, result.points);
+    const double v = morea_core::SignedVolume(t, result.points);
     EXPECT_GT(v, 0.0);
     volume += v;
   }
   EXPECT_NEAR(volume, 24.0, 1e-9);
-  EXPECT_THROW(morea::Tetrahedralize({ points[0], points[1], points[2] }), morea::Error);
-  EXPECT_THROW(morea::Tetrahedralize(points, { { { 0, 1, 99 } } }), morea::Error);
+  EXPECT_THROW(morea_core::Tetrahedralize({ points[0], points[1], points[2] }), morea_core::Error);
+  EXPECT_THROW(morea_core::Tetrahedralize(points, { { { 0, 1, 99 } } }), morea_core::Error);
 }
 
 TEST(StructureSurface, SphereSurfaceIsClosedAndDecimated)
 {
-  morea::Volume<std::uint8_t> mask({ { 40, 40, 40 } }, { { 1, 1, 1 } }, { { -20, -20, -20 } });
+  morea_core::Volume<std::uint8_t> mask({ { 40, 40, 40 } }, { { 1, 1, 1 } }, { { -20, -20, -20 } });
   for (std::size_t k = 0; k < 40; ++k)
     for (std::size_t j = 0; j < 40; ++j)
       for (std::size_t i = 0; i < 40; ++i)
         mask(i, j, k) = Distance(mask.PointAt(i, j, k), { { 0, 0, 0 } }) <= 12.0;
-  const auto surface = morea::ExtractStructureSurface(mask, 150);
+  const auto surface = morea_core::ExtractStructureSurface(mask, 150);
   EXPECT_GT(surface.vertices.size(), 100u);
   EXPECT_LT(surface.vertices.size(), 200u);
   // Closed 2-manifold: every edge is shared by exactly two triangles.
@@ -131,30 +131,30 @@ TEST(StructureSurface, SphereSurfaceIsClosedAndDecimated)
   EXPECT_EQ(surface.vertices.size() + surface.triangles.size() - edgeUse.size(), 2u); // Euler: sphere
   for (const Vec3 & v : surface.vertices)
     EXPECT_NEAR(Distance(v, { { 0, 0, 0 } }), 12.0, 1.5);
-  EXPECT_TRUE(morea::ExtractStructureSurface(mask.Like<std::uint8_t>(0), 100).triangles.empty());
+  EXPECT_TRUE(morea_core::ExtractStructureSurface(mask.Like<std::uint8_t>(0), 100).triangles.empty());
 }
 
 TEST(MeshGenerator, OptionsFollowTheMethodName)
 {
-  morea::ParameterSet p;
-  auto                o = morea::MeshGeneratorOptions::FromParameters(p);
+  morea_core::ParameterSet p;
+  auto                o = morea_core::MeshGeneratorOptions::FromParameters(p);
   EXPECT_TRUE(o.useContourPoints);
   EXPECT_DOUBLE_EQ(o.randomFraction, 0.10);
   EXPECT_EQ(o.surfaceStructures, (std::vector<std::string>{ "bladder" }));
   p.SetFromString("morea_mesh_generation_method", "annotation-group-random-20");
-  o = morea::MeshGeneratorOptions::FromParameters(p);
+  o = morea_core::MeshGeneratorOptions::FromParameters(p);
   EXPECT_DOUBLE_EQ(o.randomFraction, 0.20);
   EXPECT_TRUE(o.surfaceStructures.empty());
   p.SetFromString("morea_mesh_generation_method", "random");
-  EXPECT_FALSE(morea::MeshGeneratorOptions::FromParameters(p).useContourPoints);
+  EXPECT_FALSE(morea_core::MeshGeneratorOptions::FromParameters(p).useContourPoints);
   for (const char * bad : { "grid", "annotation-group-random-bladder-x", "annotation-group-random-200" })
   {
     p.SetFromString("morea_mesh_generation_method", bad);
-    EXPECT_THROW(morea::MeshGeneratorOptions::FromParameters(p), morea::Error) << bad;
+    EXPECT_THROW(morea_core::MeshGeneratorOptions::FromParameters(p), morea_core::Error) << bad;
   }
   p.SetFromString("morea_mesh_generation_method", "random");
   p.SetFromString("morea_mesh_structure_shares", "bladder=2, bones");
-  EXPECT_THROW(morea::MeshGeneratorOptions::FromParameters(p), morea::Error);
+  EXPECT_THROW(morea_core::MeshGeneratorOptions::FromParameters(p), morea_core::Error);
 }
 
 TEST(MeshGenerator, PhantomMeshWithBladderSurface)
@@ -175,7 +175,7 @@ TEST(MeshGenerator, PhantomMeshWithBladderSurface)
   double volume = 0.0;
   for (const auto & t : mesh.tetrahedra)
   {
-    const double v = morea::SignedVolume(t, mesh.points);
+    const double v = morea_core::SignedVolume(t, mesh.points);
     ASSERT_GT(v, 0.0);
     volume += v;
   }
@@ -209,7 +209,7 @@ TEST(MeshGenerator, PhantomMeshWithBladderSurface)
   {
     const auto & pin = mesh.pins[i];
     fixed += (pin[0] != 0 && pin[1] != 0 && pin[2] != 0);
-    EXPECT_EQ(morea::ProjectToDomain(mesh.points[i], pin, pm.domain), mesh.points[i]);
+    EXPECT_EQ(morea_core::ProjectToDomain(mesh.points[i], pin, pm.domain), mesh.points[i]);
   }
   EXPECT_EQ(fixed, 8u);
 
@@ -225,16 +225,16 @@ TEST(MeshGenerator, PhantomMeshWithBladderSurface)
 TEST(MeshGenerator, SameSeedSameMesh)
 {
   const auto &                      pm = morea_test::PhantomMesh600();
-  std::vector<morea::MeshStructure> structures;
+  std::vector<morea_core::MeshStructure> structures;
   for (std::size_t s = 1; s < pm.names.size(); ++s)
-    structures.push_back({ pm.names[s], morea::MaskBoundaryPoints(pm.phantomCase.movingMasks[s]),
+    structures.push_back({ pm.names[s], morea_core::MaskBoundaryPoints(pm.phantomCase.movingMasks[s]),
                            &pm.phantomCase.movingMasks[s] });
-  morea::MeshGeneratorOptions options;
+  morea_core::MeshGeneratorOptions options;
   options.seed = 7;
-  const auto again = morea::GenerateMesh(pm.domain, structures, options);
+  const auto again = morea_core::GenerateMesh(pm.domain, structures, options);
   EXPECT_EQ(again.points, pm.mesh.points);
   EXPECT_EQ(again.tetrahedra, pm.mesh.tetrahedra);
   options.seed = 8;
-  EXPECT_NE(morea::GenerateMesh(pm.domain, structures, options).points, pm.mesh.points);
+  EXPECT_NE(morea_core::GenerateMesh(pm.domain, structures, options).points, pm.mesh.points);
 }
 } // namespace

@@ -4,14 +4,14 @@
 // rule, guidance truncation, and CPU backend batches.
 #include "OptimiserTestProblem.h"
 
-#include "morea/MagnitudeObjective.h"
-#include "morea/Random.h"
+#include "morea_core/MagnitudeObjective.h"
+#include "morea_core/Random.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 
-using namespace morea;
+using namespace morea_core;
 using morea_test::OptimiserTestProblem;
 
 namespace

@@ -1,7 +1,7 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
 // Tests of the scrambled Sobol sampling of tetrahedra.
-#include "morea/TetrahedronSampling.h"
+#include "morea_core/TetrahedronSampling.h"
 
 #include <gtest/gtest.h>
 
@@ -10,7 +10,7 @@
 
 namespace
 {
-using morea::Vec3;
+using morea_core::Vec3;
 
 TEST(TetrahedronSampling, SobolPointsAreStratifiedInEveryDimension)
 {
@@ -18,7 +18,7 @@ TEST(TetrahedronSampling, SobolPointsAreStratifiedInEveryDimension)
   // one value of each coordinate in each interval [j/2^k, (j+1)/2^k).
   for (std::uint64_t seed : { 1u, 77u })
   {
-    morea::ScrambledSobol4            sobol(seed);
+    morea_core::ScrambledSobol4            sobol(seed);
     constexpr int                     n = 64;
     std::array<std::set<int>, 4>      cells;
     for (int i = 0; i < n; ++i)
@@ -35,7 +35,7 @@ TEST(TetrahedronSampling, SobolPointsAreStratifiedInEveryDimension)
       EXPECT_EQ(cells[d].size(), static_cast<std::size_t>(n)) << "dimension " << d;
   }
   // Pairs of dimensions are stratified too (the Sobol (0,m,2) property for dims 1-2).
-  morea::ScrambledSobol4        sobol(5);
+  morea_core::ScrambledSobol4        sobol(5);
   std::set<std::pair<int, int>> squares;
   for (int i = 0; i < 64; ++i)
   {
@@ -47,7 +47,7 @@ TEST(TetrahedronSampling, SobolPointsAreStratifiedInEveryDimension)
 
 TEST(TetrahedronSampling, SameSeedSameSamplesOtherSeedOtherSamples)
 {
-  morea::ScrambledSobol4 a(9), b(9), c(10);
+  morea_core::ScrambledSobol4 a(9), b(9), c(10);
   for (int i = 0; i < 10; ++i)
   {
     const auto ua = a.Next(), ub = b.Next(), uc = c.Next();
@@ -57,20 +57,20 @@ TEST(TetrahedronSampling, SameSeedSameSamplesOtherSeedOtherSamples)
   const Vec3 p{ { 1, 2, 3 } }, q{ { 4, 2, 3 } }, r{ { 1, 6, 3 } }, s{ { 1, 2, 9 } };
   Vec3       nudged = s;
   nudged[2] = std::nextafter(nudged[2], 10.0);
-  EXPECT_EQ(morea::TetrahedronSeed(p, q, r, s), morea::TetrahedronSeed(p, q, r, s));
-  EXPECT_NE(morea::TetrahedronSeed(p, q, r, s), morea::TetrahedronSeed(p, q, r, nudged));
+  EXPECT_EQ(morea_core::TetrahedronSeed(p, q, r, s), morea_core::TetrahedronSeed(p, q, r, s));
+  EXPECT_NE(morea_core::TetrahedronSeed(p, q, r, s), morea_core::TetrahedronSeed(p, q, r, nudged));
 }
 
 TEST(TetrahedronSampling, BarycentricSamplesFillTheTetrahedronUniformly)
 {
   const Vec3             v[4] = { { { 0, 0, 0 } }, { { 6, 0, 0 } }, { { 0, 6, 0 } }, { { 0, 0, 6 } } };
-  morea::ScrambledSobol4 sobol(morea::TetrahedronSeed(v[0], v[1], v[2], v[3]));
+  morea_core::ScrambledSobol4 sobol(morea_core::TetrahedronSeed(v[0], v[1], v[2], v[3]));
   Vec3                   mean{ { 0, 0, 0 } };
   constexpr int          n = 1024;
   int                    nearCorner = 0;
   for (int i = 0; i < n; ++i)
   {
-    const auto w = morea::UniformBarycentric(sobol.Next());
+    const auto w = morea_core::UniformBarycentric(sobol.Next());
     double     sum = 0.0;
     for (double x : w)
     {

@@ -3,7 +3,7 @@
 // The thread pool: every index runs exactly once whatever the count and the
 // number of threads, an exception reaches the caller and stops the work, and
 // the pool stays usable for the next call.
-#include "morea/ThreadPool.h"
+#include "morea_core/ThreadPool.h"
 
 #include <gtest/gtest.h>
 
@@ -13,7 +13,7 @@
 #include <stdexcept>
 #include <vector>
 
-using morea::ThreadPool;
+using morea_core::ThreadPool;
 
 TEST(ThreadPool, RunsEveryIndexExactlyOnce)
 {
@@ -117,7 +117,7 @@ TEST(ThreadPool, SharedPoolsAndCallsWithinCalls)
 // one at a time; Wait returns once the job has ended, with its exception.
 TEST(BackgroundWorker, RunsJobsBesideTheCallerInTurnAndPassesOnTheirErrors)
 {
-  morea::BackgroundWorker worker;
+  morea_core::BackgroundWorker worker;
   worker.Wait(); // none started: returns at once
   const std::thread::id caller = std::this_thread::get_id();
   std::thread::id       ran;
@@ -158,7 +158,7 @@ TEST(BackgroundWorker, TheDestructorWaitsForTheJobUnderWay)
 {
   std::atomic<int> finished{ 0 };
   {
-    morea::BackgroundWorker worker;
+    morea_core::BackgroundWorker worker;
     worker.Start([&finished] {
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
       finished.store(1);
@@ -174,7 +174,7 @@ TEST(BackgroundWorker, TheDestructorWaitsForTheJobUnderWay)
 // scheduler runs only where nothing else wants the core.
 TEST(ThreadPool, IdlePriorityWorkersRunAtIdlePriority)
 {
-  ThreadPool                 pool(4, morea::WorkerPriority::Idle);
+  ThreadPool                 pool(4, morea_core::WorkerPriority::Idle);
   const std::thread::id      caller = std::this_thread::get_id();
   std::atomic<int>           ran{ 0 }, idle{ 0 }, others{ 0 };
   const int                  callerPolicy = sched_getscheduler(0);
@@ -198,7 +198,7 @@ TEST(ThreadPool, IdlePriorityWorkersRunAtIdlePriority)
   ASSERT_GT(others.load(), 0) << "the workers took part";
   EXPECT_EQ(idle.load(), others.load()) << "every worker runs at idle priority";
   EXPECT_EQ(sched_getscheduler(0), callerPolicy) << "the caller keeps its own";
-  morea::BackgroundWorker worker(morea::WorkerPriority::Idle);
+  morea_core::BackgroundWorker worker(morea_core::WorkerPriority::Idle);
   int                     policy = -1;
   worker.Start([&policy] { policy = sched_getscheduler(0); });
   worker.Wait();

@@ -1,8 +1,8 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/VtuWriter.h"
+#include "morea_core/VtuWriter.h"
 
-#include "morea/Error.h"
+#include "morea_core/Error.h"
 
 #include "BoxMesh.h"
 
@@ -51,7 +51,7 @@ ReadVtu(const fs::path & path)
 morea_test::BoxMesh
 SmallMesh()
 {
-  morea::MeshDomain domain;
+  morea_core::MeshDomain domain;
   domain.lower = { { -1.5, 2.0, 10.0 } };
   domain.upper = { { 4.5, 6.0, 13.0 } };
   return morea_test::MakeBoxMesh(domain, { 2, 1, 1 });
@@ -64,17 +64,17 @@ TEST(VtuWriter, RoundTripKeepsPointsCellsAndData)
   const fs::path folder = OutputFolder("round_trip");
   const fs::path path = folder / "mesh.vtu";
 
-  morea::VtuArray volume{ "volume", {} };
-  morea::VtuArray label{ "label", {} };
+  morea_core::VtuArray volume{ "volume", {} };
+  morea_core::VtuArray label{ "label", {} };
   for (std::size_t t = 0; t < mesh.tetrahedra.size(); ++t)
   {
-    volume.values.push_back(morea::SignedVolume(mesh.tetrahedra[t], mesh.points));
+    volume.values.push_back(morea_core::SignedVolume(mesh.tetrahedra[t], mesh.points));
     label.values.push_back(0.5 * static_cast<double>(t) - 1.0);
   }
-  morea::VtuArray height{ "height", {} };
+  morea_core::VtuArray height{ "height", {} };
   for (const auto & p : mesh.points)
     height.values.push_back(p[2] * 1.25);
-  morea::WriteVtu(path.string(), mesh.points, mesh.tetrahedra, { volume, label }, { height });
+  morea_core::WriteVtu(path.string(), mesh.points, mesh.tetrahedra, { volume, label }, { height });
   EXPECT_EQ(FilesIn(folder), 1u) << "the temporary file must be gone";
 
   const auto grid = ReadVtu(path);
@@ -124,13 +124,13 @@ TEST(VtuWriter, UnwritablePathThrowsAndLeavesNoFile)
   const fs::path blocker = folder / "not_a_folder";
   std::ofstream(blocker) << "x";
   const fs::path underFile = blocker / "mesh.vtu";
-  EXPECT_THROW(morea::WriteVtu(underFile.string(), mesh.points, mesh.tetrahedra, {}), morea::Error);
+  EXPECT_THROW(morea_core::WriteVtu(underFile.string(), mesh.points, mesh.tetrahedra, {}), morea_core::Error);
   EXPECT_FALSE(fs::exists(underFile));
   // A folder where the file should be: the rename fails, the temporary goes.
   const fs::path occupied = folder / "occupied.vtu";
   fs::create_directory(occupied);
   fs::create_directory(occupied / "keep");
-  EXPECT_THROW(morea::WriteVtu(occupied.string(), mesh.points, mesh.tetrahedra, {}), morea::Error);
+  EXPECT_THROW(morea_core::WriteVtu(occupied.string(), mesh.points, mesh.tetrahedra, {}), morea_core::Error);
   EXPECT_TRUE(fs::is_directory(occupied));
   EXPECT_EQ(FilesIn(folder), 2u) << "only the blocker file and the occupied folder may remain";
 }
@@ -140,12 +140,12 @@ TEST(VtuWriter, BadSizesThrow)
   const auto     mesh = SmallMesh();
   const fs::path folder = OutputFolder("bad_sizes");
   const fs::path path = folder / "mesh.vtu";
-  EXPECT_THROW(morea::WriteVtu(path.string(), mesh.points, mesh.tetrahedra, { { "short", { 1.0 } } }), morea::Error);
-  EXPECT_THROW(morea::WriteVtu(
+  EXPECT_THROW(morea_core::WriteVtu(path.string(), mesh.points, mesh.tetrahedra, { { "short", { 1.0 } } }), morea_core::Error);
+  EXPECT_THROW(morea_core::WriteVtu(
                  path.string(), mesh.points, mesh.tetrahedra, {}, { { "", std::vector<double>(mesh.points.size()) } }),
-               morea::Error);
+               morea_core::Error);
   auto badTetrahedra = mesh.tetrahedra;
   badTetrahedra[0][3] = static_cast<std::uint32_t>(mesh.points.size());
-  EXPECT_THROW(morea::WriteVtu(path.string(), mesh.points, badTetrahedra, {}), morea::Error);
+  EXPECT_THROW(morea_core::WriteVtu(path.string(), mesh.points, badTetrahedra, {}), morea_core::Error);
   EXPECT_EQ(FilesIn(folder), 0u);
 }

@@ -17,7 +17,7 @@
 
 #include <unistd.h>
 
-namespace morea::cli
+namespace morea_cli
 {
 namespace
 {
@@ -62,4 +62,4 @@ AddBatchCommand(CLI::App & app)
                              "); install Python 3 with the package morea, or set MOREA_PYTHON");
   });
 }
-} // namespace morea::cli
+} // namespace morea_cli

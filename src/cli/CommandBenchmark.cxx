@@ -11,13 +11,13 @@
 #include "itkMeshRegistration.h"
 #include "itkObjectiveData.h"
 #include "itkPreprocessing.h"
-#include "morea/ComputeDevices.h"
-#include "morea/EvaluationBackend.h"
-#include "morea/FoldConstraint.h"
-#include "morea/InitialPopulation.h"
-#include "morea/MemoryEstimate.h"
-#include "morea/MoRvGomea.h"
-#include "morea/TetrahedronObjectives.h"
+#include "morea_core/ComputeDevices.h"
+#include "morea_core/EvaluationBackend.h"
+#include "morea_core/FoldConstraint.h"
+#include "morea_core/InitialPopulation.h"
+#include "morea_core/MemoryEstimate.h"
+#include "morea_core/MoRvGomea.h"
+#include "morea_core/TetrahedronObjectives.h"
 
 #include <algorithm>
 #include <chrono>
@@ -28,7 +28,7 @@
 #include <sstream>
 #include <thread>
 
-namespace morea::cli
+namespace morea_cli
 {
 namespace
 {
@@ -301,4 +301,4 @@ AddBenchmarkCommand(CLI::App & app)
     std::cout << "wrote " << options->output << "\n";
   });
 }
-} // namespace morea::cli
+} // namespace morea_cli

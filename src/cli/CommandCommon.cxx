@@ -4,7 +4,7 @@
 
 #include "itkLandmarkIO.h"
 #include "itkMOREAImageIO.h"
-#include "morea/Error.h"
+#include "morea_core/Error.h"
 
 #include <cstdio>
 #include <filesystem>
@@ -13,7 +13,7 @@
 
 namespace fs = std::filesystem;
 
-namespace morea::cli
+namespace morea_cli
 {
 namespace
 {
@@ -196,4 +196,4 @@ WriteJson(const nlohmann::json & json, const std::string & path)
 {
   itk::morea::WriteTextFile(json.dump(2) + "\n", path);
 }
-} // namespace morea::cli
+} // namespace morea_cli

@@ -7,7 +7,7 @@
 
 #include "itkRegistrationEvaluation.h"
 #include "itkRegistrationProblem.h"
-#include "morea/ParameterSet.h"
+#include "morea_core/ParameterSet.h"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -16,8 +16,11 @@
 #include <string>
 #include <vector>
 
-namespace morea::cli
+namespace morea_cli
 {
+// The command line speaks the core's vocabulary (ParameterSet, Error, ...).
+using namespace morea_core;
+
 /** Options that describe a registration problem on the command line. */
 struct ProblemOptions
 {
@@ -89,6 +92,6 @@ AddBatchCommand(CLI::App & app);
 /** `morea view`: the front navigator page of a run's folder. */
 void
 AddViewCommand(CLI::App & app);
-} // namespace morea::cli
+} // namespace morea_cli
 
 #endif

@@ -13,15 +13,15 @@
 #include "itkPhantomImages.h"
 #include "itkPreprocessing.h"
 #include "itkRegistrationOutputs.h"
-#include "morea/ComputeDevices.h"
-#include "morea/OutputFolderLock.h"
+#include "morea_core/ComputeDevices.h"
+#include "morea_core/OutputFolderLock.h"
 
 #include <chrono>
 #include <filesystem>
 #include <iostream>
 #include <memory>
 
-namespace morea::cli
+namespace morea_cli
 {
 namespace
 {
@@ -175,4 +175,4 @@ AddInfoCommand(CLI::App & app)
                 << d.multiprocessors << " SMs\n";
   });
 }
-} // namespace morea::cli
+} // namespace morea_cli

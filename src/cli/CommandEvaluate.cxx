@@ -10,7 +10,7 @@
 #include <iostream>
 #include <memory>
 
-namespace morea::cli
+namespace morea_cli
 {
 void
 AddEvaluateCommand(CLI::App & app)
@@ -57,4 +57,4 @@ AddEvaluateCommand(CLI::App & app)
       itk::morea::RenderComparison(problem, forward, options->focus, options->renderPrefix);
   });
 }
-} // namespace morea::cli
+} // namespace morea_cli

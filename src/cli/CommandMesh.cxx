@@ -6,8 +6,8 @@
 #include "itkMOREAImageIO.h"
 #include "itkMeshModel.h"
 #include "itkPreprocessing.h"
-#include "morea/FoldConstraint.h"
-#include "morea/InitialPopulation.h"
+#include "morea_core/FoldConstraint.h"
+#include "morea_core/InitialPopulation.h"
 
 #include <chrono>
 #include <filesystem>
@@ -15,7 +15,7 @@
 #include <memory>
 #include <utility>
 
-namespace morea::cli
+namespace morea_cli
 {
 namespace
 {
@@ -88,18 +88,18 @@ AddMeshCommand(CLI::App & app)
     const auto model = itk::morea::BuildMeshModel(problem, parameters);
     std::filesystem::create_directories(options->output);
     const std::string out = options->output + "/";
-    const auto        base = ::morea::DualMesh::FromBase(model.base);
+    const auto        base = morea_core::DualMesh::FromBase(model.base);
     itk::morea::WriteSolutionMeshes(model, base, out + "mesh_moving.vtu", out + "mesh_fixed.vtu");
 
     nlohmann::json report = ReportToJson(model);
     if (options->samples > 0)
     {
       const auto                  start = std::chrono::steady_clock::now();
-      const ::morea::FoldConstraint constraint(model.topology, model.base.points,
+      const morea_core::FoldConstraint constraint(model.topology, model.base.points,
                                                 parameters.GetReal("morea_fold_volume_fraction"));
-      const auto population = ::morea::GenerateInitialPopulation(
+      const auto population = morea_core::GenerateInitialPopulation(
         model.base, constraint, options->samples + 1, static_cast<std::uint64_t>(parameters.GetInteger("seed")),
-        ::morea::InitialPopulationOptions::FromParameters(parameters));
+        morea_core::InitialPopulationOptions::FromParameters(parameters));
       for (std::size_t i = 1; i < population.size(); ++i)
       {
         const std::string prefix = out + "initial_" + std::to_string(i) + "_";
@@ -121,4 +121,4 @@ AddMeshCommand(CLI::App & app)
     std::cout << "written to " << options->output << "\n";
   });
 }
-} // namespace morea::cli
+} // namespace morea_cli

@@ -8,7 +8,7 @@
 #include <iostream>
 #include <sstream>
 
-namespace morea::cli
+namespace morea_cli
 {
 namespace
 {
@@ -81,4 +81,4 @@ AddParametersCommand(CLI::App & app)
     }
   });
 }
-} // namespace morea::cli
+} // namespace morea_cli

@@ -8,7 +8,7 @@
 #include <iostream>
 #include <memory>
 
-namespace morea::cli
+namespace morea_cli
 {
 void
 AddPhantomCommand(CLI::App & app)
@@ -57,4 +57,4 @@ AddPhantomCommand(CLI::App & app)
     std::cout << phantomOptions.caseName << " phantom written to " << options->output << "\n";
   });
 }
-} // namespace morea::cli
+} // namespace morea_cli

@@ -8,7 +8,7 @@
 #include <iostream>
 #include <memory>
 
-namespace morea::cli
+namespace morea_cli
 {
 namespace
 {
@@ -67,4 +67,4 @@ AddPreprocessCommand(CLI::App & app)
     std::cout << "written to " << options->output << "\n";
   });
 }
-} // namespace morea::cli
+} // namespace morea_cli

@@ -10,8 +10,8 @@
 
 #include "itkMOREAImageIO.h"
 #include "itkRegistrationOutputs.h"
-#include "morea/ComputeDevices.h"
-#include "morea/OutputFolderLock.h"
+#include "morea_core/ComputeDevices.h"
+#include "morea_core/OutputFolderLock.h"
 
 #include <chrono>
 #include <csignal>
@@ -20,7 +20,7 @@
 #include <memory>
 #include <optional>
 
-namespace morea::cli
+namespace morea_cli
 {
 namespace
 {
@@ -70,7 +70,7 @@ RegisterOnce(const itk::morea::RegistrationProblem & input, const ParameterSet &
   settings.resume = options.resume;
   settings.initialTransform = initialTransform;
   settings.onGeneration = [print = ProgressPrinter(), killAfter = options.killAfter](
-                            const ::morea::GenerationRecord & r, std::size_t total) {
+                            const morea_core::GenerationRecord & r, std::size_t total) {
     print(r, total);
     if (killAfter > 0 && r.generation == killAfter)
       std::raise(SIGKILL);
@@ -179,7 +179,7 @@ AddRegisterCommand(CLI::App & app)
     if (options->device)
       parameters.SetFromString("cuda_gpu_id", std::to_string(*options->device));
     // The device's context is made while the problem is read and preprocessed.
-    std::optional<::morea::CudaContextWarmUp> warmUp;
+    std::optional<morea_core::CudaContextWarmUp> warmUp;
     if (options->backend != "cpu")
       warmUp.emplace(static_cast<int>(parameters.GetInteger("cuda_gpu_id")));
     itk::morea::CheckSolutionSelection(options->select); // before a long run, not after
@@ -217,4 +217,4 @@ AddRegisterCommand(CLI::App & app)
     }
   });
 }
-} // namespace morea::cli
+} // namespace morea_cli

@@ -6,7 +6,7 @@
 #include "CommandCommon.h"
 
 #include "itkRegistrationRunFolder.h"
-#include "morea/Error.h"
+#include "morea_core/Error.h"
 
 #include <cerrno>
 #include <cstdlib>
@@ -17,7 +17,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-namespace morea::cli
+namespace morea_cli
 {
 namespace
 {
@@ -105,4 +105,4 @@ AddViewCommand(CLI::App & app)
     throw Error("cannot start '" + python + "': " + std::strerror(errno));
   });
 }
-} // namespace morea::cli
+} // namespace morea_cli

@@ -4,13 +4,15 @@
 
 #include "itkCommand.h"
 #include "itkTransformFileReader.h"
-#include "morea/Error.h"
+#include "morea_core/Error.h"
 
 #include <algorithm>
 #include <thread>
 
-namespace morea::cli
+namespace morea_cli
 {
+using namespace morea_core;
+
 namespace
 {
 using PointSetType = RegistrationFilterType::PointSetType;
@@ -107,4 +109,4 @@ UpdateRegistrationFilter(RegistrationFilterType & filter)
     throw Error(itk::morea::UserMessage(e.GetDescription()));
   }
 }
-} // namespace morea::cli
+} // namespace morea_cli

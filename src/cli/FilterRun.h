@@ -7,12 +7,12 @@
 
 #include "itkMultiObjectiveMeshRegistrationFilter.h"
 #include "itkRegistrationProblem.h"
-#include "morea/ParameterSet.h"
+#include "morea_core/ParameterSet.h"
 
 #include <functional>
 #include <string>
 
-namespace morea::cli
+namespace morea_cli
 {
 using RegistrationFilterType = itk::MultiObjectiveMeshRegistrationFilter<itk::morea::ImageType, itk::morea::ImageType>;
 
@@ -29,25 +29,25 @@ struct FilterSettings
   /** Pre-alignment given instead of the rigid step; null: none. */
   RegistrationFilterType::InitialTransformType::ConstPointer initialTransform;
   /** After each generation run (not the ones restored from a checkpoint). */
-  std::function<void(const ::morea::GenerationRecord &, std::size_t generations)> onGeneration;
+  std::function<void(const morea_core::GenerationRecord &, std::size_t generations)> onGeneration;
 };
 
 /** A filter with `problem`'s images, structures (masks and points), body
  *  masks and landmarks as its inputs, and `parameters` and `settings` set;
  *  not yet updated. */
 RegistrationFilterType::Pointer
-MakeRegistrationFilter(const itk::morea::RegistrationProblem & problem, const ParameterSet & parameters,
+MakeRegistrationFilter(const itk::morea::RegistrationProblem & problem, const morea_core::ParameterSet & parameters,
                        const FilterSettings & settings);
 
 /** The one transform in an ITK transform file (.tfm, .txt, .h5, ANTs .mat);
- *  throws morea::Error naming the file otherwise. */
+ *  throws morea_core::Error naming the file otherwise. */
 RegistrationFilterType::InitialTransformType::Pointer
 ReadTransformFile(const std::string & path);
 
-/** Updates the filter; its ITK exceptions become morea::Error with the
+/** Updates the filter; its ITK exceptions become morea_core::Error with the
  *  filter's description (no source location), as the CLI prints them. */
 void
 UpdateRegistrationFilter(RegistrationFilterType & filter);
-} // namespace morea::cli
+} // namespace morea_cli
 
 #endif

@@ -9,13 +9,13 @@
 
 #include <unistd.h>
 
-namespace morea::cli
+namespace morea_cli
 {
-std::function<void(const ::morea::GenerationRecord &, std::size_t)>
+std::function<void(const morea_core::GenerationRecord &, std::size_t)>
 ProgressPrinter()
 {
   const bool terminal = isatty(fileno(stdout)) != 0;
-  return [terminal](const ::morea::GenerationRecord & r, std::size_t total) {
+  return [terminal](const morea_core::GenerationRecord & r, std::size_t total) {
     char line[320];
     std::snprintf(line, sizeof line, "generation %zu/%zu  front %zu  best guidance %.4g  hypervolume %.4f  %.2f s",
                   r.generation, total, r.archiveSize, r.bestGuidance, r.hypervolume, r.seconds);
@@ -43,4 +43,4 @@ ProgressPrinter()
   };
 }
 
-} // namespace morea::cli
+} // namespace morea_cli

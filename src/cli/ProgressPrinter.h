@@ -4,16 +4,16 @@
 #ifndef morea_cli_ProgressPrinter_h
 #define morea_cli_ProgressPrinter_h
 
-#include "morea/MoRvGomea.h"
+#include "morea_core/MoRvGomea.h"
 
 #include <functional>
 
-namespace morea::cli
+namespace morea_cli
 {
 /** A terminal progress line per generation (a bar on a terminal, every 10th
  *  generation otherwise). */
-std::function<void(const ::morea::GenerationRecord &, std::size_t)>
+std::function<void(const morea_core::GenerationRecord &, std::size_t)>
 ProgressPrinter();
-} // namespace morea::cli
+} // namespace morea_cli
 
 #endif

@@ -3,8 +3,8 @@
 #include "ZipArchive.h"
 
 #include "itkMOREAImageIO.h"
-#include "morea/Error.h"
-#include "morea/OutputFolderLock.h"
+#include "morea_core/Error.h"
+#include "morea_core/OutputFolderLock.h"
 
 #include <zlib.h>
 
@@ -16,8 +16,10 @@
 #include <limits>
 #include <vector>
 
-namespace morea::cli
+namespace morea_cli
 {
+using namespace morea_core;
+
 namespace
 {
 namespace fs = std::filesystem;
@@ -151,4 +153,4 @@ ZipFolder(const std::string & folder)
   itk::morea::WriteTextFile(body, archive);
   return archive;
 }
-} // namespace morea::cli
+} // namespace morea_cli

@@ -6,15 +6,15 @@
 
 #include <string>
 
-namespace morea::cli
+namespace morea_cli
 {
 /** Writes FOLDER.zip beside `folder` with every regular file under it
  *  (deflated, paths relative to the folder's parent, so that unzipping
  *  gives the folder back); written under a temporary name and renamed into
- *  place. Returns the archive's path. Throws morea::Error on failure, and
+ *  place. Returns the archive's path. Throws morea_core::Error on failure, and
  *  for files of 4 GiB or more (no ZIP64). */
 std::string
 ZipFolder(const std::string & folder);
-} // namespace morea::cli
+} // namespace morea_cli
 
 #endif

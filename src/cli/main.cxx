@@ -4,7 +4,7 @@
 #include "CommandCommon.h"
 
 #include "itkMacro.h"
-#include "morea/Error.h"
+#include "morea_core/Error.h"
 
 #include <iostream>
 
@@ -14,17 +14,17 @@ main(int argc, char ** argv)
   CLI::App app{ "morea: multi-objective deformable registration of 3D images with large deformations" };
   app.require_subcommand(1);
   app.set_version_flag("--version", "morea 0.1.0");
-  morea::cli::AddPhantomCommand(app);
-  morea::cli::AddPreprocessCommand(app);
-  morea::cli::AddEvaluateCommand(app);
-  morea::cli::AddMeshCommand(app);
-  morea::cli::AddRegisterCommand(app);
-  morea::cli::AddDemoCommand(app);
-  morea::cli::AddBenchmarkCommand(app);
-  morea::cli::AddInfoCommand(app);
-  morea::cli::AddParametersCommand(app);
-  morea::cli::AddBatchCommand(app);
-  morea::cli::AddViewCommand(app);
+  morea_cli::AddPhantomCommand(app);
+  morea_cli::AddPreprocessCommand(app);
+  morea_cli::AddEvaluateCommand(app);
+  morea_cli::AddMeshCommand(app);
+  morea_cli::AddRegisterCommand(app);
+  morea_cli::AddDemoCommand(app);
+  morea_cli::AddBenchmarkCommand(app);
+  morea_cli::AddInfoCommand(app);
+  morea_cli::AddParametersCommand(app);
+  morea_cli::AddBatchCommand(app);
+  morea_cli::AddViewCommand(app);
   try
   {
     app.parse(argc, argv);

@@ -1,8 +1,8 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/CheckpointWriter.h"
+#include "morea_core/CheckpointWriter.h"
 
-#include "morea/Error.h"
+#include "morea_core/Error.h"
 
 #include <cstdio>
 #include <cstring>
@@ -20,7 +20,7 @@
 #  define MOREA_POSIX_FILES 0
 #endif
 
-namespace morea
+namespace morea_core
 {
 #if MOREA_POSIX_FILES
 namespace
@@ -157,4 +157,4 @@ CheckpointWriter::Wait()
   if (m_Error)
     std::rethrow_exception(std::exchange(m_Error, nullptr));
 }
-} // namespace morea
+} // namespace morea_core

@@ -3,17 +3,17 @@
 // The CPU evaluation backend: the reference implementation of
 // EvaluationBackend, multi-threaded over the tetrahedra of whole solutions and
 // over the candidates of a parallel group.
-#include "morea/EvaluationBackend.h"
+#include "morea_core/EvaluationBackend.h"
 
-#include "morea/Error.h"
-#include "morea/Random.h"
-#include "morea/ThreadPool.h"
+#include "morea_core/Error.h"
+#include "morea_core/Random.h"
+#include "morea_core/ThreadPool.h"
 
 #include <algorithm>
 #include <array>
 #include <chrono>
 
-namespace morea
+namespace morea_core
 {
 Corners
 CornersWithReplacedPoints(const Tetrahedron & t, const std::vector<Vec3> & points,
@@ -272,4 +272,4 @@ CreateCpuEvaluationBackend(const TetrahedronEvaluator & evaluator, std::size_t t
 {
   return std::make_unique<CpuEvaluationBackend>(evaluator, threads);
 }
-} // namespace morea
+} // namespace morea_core

@@ -1,15 +1,15 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/ElasticityFactors.h"
+#include "morea_core/ElasticityFactors.h"
 
-#include "morea/Error.h"
-#include "morea/ParameterSet.h"
-#include "morea/Random.h"
+#include "morea_core/Error.h"
+#include "morea_core/ParameterSet.h"
+#include "morea_core/Random.h"
 
 #include <algorithm>
 #include <cmath>
 
-namespace morea
+namespace morea_core
 {
 namespace
 {
@@ -129,4 +129,4 @@ ParseElasticityFactors(const std::string & text)
       throw Error("parameter morea_elasticity_factors: factor of " + name + " must be positive");
   return factors;
 }
-} // namespace morea
+} // namespace morea_core

@@ -1,8 +1,8 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/ElitistArchive.h"
+#include "morea_core/ElitistArchive.h"
 
-#include "morea/Error.h"
+#include "morea_core/Error.h"
 
 #include <algorithm>
 #include <cmath>
@@ -10,7 +10,7 @@
 #include <numeric>
 #include <string>
 
-namespace morea
+namespace morea_core
 {
 namespace
 {
@@ -732,4 +732,4 @@ ElitistArchive::Restore(std::vector<ArchiveEntry> entries, bool discretised, con
   RefreshCells();
   ++m_Revision;
 }
-} // namespace morea
+} // namespace morea_core

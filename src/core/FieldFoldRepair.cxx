@@ -1,15 +1,15 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/FieldFoldRepair.h"
+#include "morea_core/FieldFoldRepair.h"
 
-#include "morea/Error.h"
+#include "morea_core/Error.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
 
-namespace morea
+namespace morea_core
 {
 namespace
 {
@@ -193,4 +193,4 @@ RemoveVoxelFolds(Volume<Vec3> & field, const FieldFoldRepairOptions & options)
   }
   return report;
 }
-} // namespace morea
+} // namespace morea_core

@@ -1,12 +1,12 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/FoldConstraint.h"
+#include "morea_core/FoldConstraint.h"
 
-#include "morea/Error.h"
+#include "morea_core/Error.h"
 
 #include <cmath>
 
-namespace morea
+namespace morea_core
 {
 FoldConstraint::FoldConstraint(const MeshTopology & topology, const std::vector<Vec3> & reference,
                                double volumeFraction)
@@ -117,4 +117,4 @@ FoldConstraint::FoldedTetrahedra(const std::vector<Vec3> & points) const
   }
   return folded;
 }
-} // namespace morea
+} // namespace morea_core

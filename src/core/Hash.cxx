@@ -1,10 +1,10 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/Hash.h"
+#include "morea_core/Hash.h"
 
 #include <cstring>
 
-namespace morea
+namespace morea_core
 {
 namespace
 {
@@ -107,4 +107,4 @@ HashText(std::uint64_t hash)
     text[static_cast<std::size_t>(i)] = digits[hash & 15];
   return text;
 }
-} // namespace morea
+} // namespace morea_core

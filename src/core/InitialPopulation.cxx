@@ -1,14 +1,14 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/InitialPopulation.h"
+#include "morea_core/InitialPopulation.h"
 
-#include "morea/ParallelForThreads.h"
-#include "morea/ParameterSet.h"
+#include "morea_core/ParallelForThreads.h"
+#include "morea_core/ParameterSet.h"
 
 #include <algorithm>
 #include <cmath>
 
-namespace morea
+namespace morea_core
 {
 namespace
 {
@@ -124,4 +124,4 @@ GenerateInitialPopulation(const TetrahedralMesh & base, const FoldConstraint & c
   });
   return population;
 }
-} // namespace morea
+} // namespace morea_core

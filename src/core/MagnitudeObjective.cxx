@@ -1,12 +1,12 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/MagnitudeObjective.h"
+#include "morea_core/MagnitudeObjective.h"
 
-#include "morea/Error.h"
+#include "morea_core/Error.h"
 
 #include <cmath>
 
-namespace morea
+namespace morea_core
 {
 namespace
 {
@@ -78,4 +78,4 @@ MagnitudeObjective(const MeshTopology & topology, const DualMesh & solution, con
   }
   return n ? sum / (10.0 * static_cast<double>(n)) : 0.0;
 }
-} // namespace morea
+} // namespace morea_core

@@ -5,10 +5,10 @@
 // keeps (MoRvGomeaParts.h).
 #include "MoRvGomeaParts.h"
 
-#include "morea/Error.h"
-#include "morea/EvaluationBackend.h"
-#include "morea/MemoryEstimate.h"
-#include "morea/ParameterSet.h"
+#include "morea_core/Error.h"
+#include "morea_core/EvaluationBackend.h"
+#include "morea_core/MemoryEstimate.h"
+#include "morea_core/ParameterSet.h"
 
 #include <algorithm>
 #include <cmath>
@@ -16,7 +16,7 @@
 #include <fstream>
 #include <sstream>
 
-namespace morea
+namespace morea_core
 {
 namespace
 {
@@ -279,4 +279,4 @@ CheckRunMemory(const ParameterSet & parameters)
   if (!shortfall.empty())
     throw Error(shortfall);
 }
-} // namespace morea
+} // namespace morea_core

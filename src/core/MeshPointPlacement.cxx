@@ -1,12 +1,12 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/MeshPointPlacement.h"
+#include "morea_core/MeshPointPlacement.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-namespace morea
+namespace morea_core
 {
 namespace
 {
@@ -127,4 +127,4 @@ DomainCorners(const MeshDomain & domain)
   }
   return corners;
 }
-} // namespace morea
+} // namespace morea_core

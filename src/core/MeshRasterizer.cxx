@@ -1,9 +1,9 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/MeshRasterizer.h"
+#include "morea_core/MeshRasterizer.h"
 
-#include "morea/Error.h"
-#include "morea/ParallelForThreads.h"
+#include "morea_core/Error.h"
+#include "morea_core/ParallelForThreads.h"
 
 #include <algorithm>
 #include <cmath>
@@ -11,7 +11,7 @@
 #include <limits>
 #include <string>
 
-namespace morea
+namespace morea_core
 {
 namespace
 {
@@ -368,4 +368,4 @@ RasterizeDisplacement(const MeshTopology & topology, const std::vector<Vec3> & f
     }
   });
 }
-} // namespace morea
+} // namespace morea_core

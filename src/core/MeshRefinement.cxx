@@ -1,9 +1,9 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/MeshRefinement.h"
+#include "morea_core/MeshRefinement.h"
 
-#include "morea/Error.h"
-#include "morea/ParameterSet.h"
+#include "morea_core/Error.h"
+#include "morea_core/ParameterSet.h"
 
 #include <algorithm>
 #include <cmath>
@@ -12,7 +12,7 @@
 #include <tuple>
 #include <unordered_map>
 
-namespace morea
+namespace morea_core
 {
 namespace
 {
@@ -346,4 +346,4 @@ RefinementDensity(const TetrahedralMesh & base, const std::vector<std::vector<Te
   }
   return density;
 }
-} // namespace morea
+} // namespace morea_core

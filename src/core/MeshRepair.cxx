@@ -1,15 +1,15 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/MeshRepair.h"
+#include "morea_core/MeshRepair.h"
 
-#include "morea/RepairNoise.h"
-#include "morea/RepairStar.h"
+#include "morea_core/RepairNoise.h"
+#include "morea_core/RepairStar.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
-namespace morea
+namespace morea_core
 {
 namespace
 {
@@ -189,4 +189,4 @@ RepairFolds(DualMesh & solution, const TetrahedralMesh & base, const FoldConstra
   source.movedPoints += target.movedPoints;
   return source;
 }
-} // namespace morea
+} // namespace morea_core

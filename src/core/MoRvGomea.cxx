@@ -6,11 +6,11 @@
 // MoRvGomeaAcceptance.cxx.
 #include "MoRvGomeaParts.h"
 
-#include "morea/Error.h"
-#include "morea/MeshRepair.h"
-#include "morea/ParameterSet.h"
-#include "morea/RefusalBound.h"
-#include "morea/ThreadPool.h"
+#include "morea_core/Error.h"
+#include "morea_core/MeshRepair.h"
+#include "morea_core/ParameterSet.h"
+#include "morea_core/RefusalBound.h"
+#include "morea_core/ThreadPool.h"
 
 #include <algorithm>
 #include <atomic>
@@ -19,7 +19,7 @@
 #include <limits>
 #include <numeric>
 
-namespace morea
+namespace morea_core
 {
 GomeaOptions
 GomeaOptions::FromParameters(const ParameterSet & p)
@@ -606,4 +606,4 @@ MoRvGomea::Run(const std::function<void(const GenerationRecord &)> & onGeneratio
       onGeneration(m_History.back());
   }
 }
-} // namespace morea
+} // namespace morea_core

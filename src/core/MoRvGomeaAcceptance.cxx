@@ -4,9 +4,9 @@
 // evaluation and its acceptance in a fixed order; and forced improvements.
 #include "MoRvGomeaParts.h"
 
-#include "morea/Error.h"
-#include "morea/RefusalBound.h"
-#include "morea/ThreadPool.h"
+#include "morea_core/Error.h"
+#include "morea_core/RefusalBound.h"
+#include "morea_core/ThreadPool.h"
 
 #include <algorithm>
 #include <atomic>
@@ -15,7 +15,7 @@
 #include <limits>
 #include <numeric>
 
-namespace morea
+namespace morea_core
 {
 // Small helpers the acceptance calls once per candidate, defined here so
 // that they inline there.
@@ -516,4 +516,4 @@ MoRvGomea::ForcedImprovement(std::size_t s, int singleObjective, RandomGenerator
     record.tetrahedronEvaluations += static_cast<double>(m_Topology.NumberOfTetrahedra());
   }
 }
-} // namespace morea
+} // namespace morea_core

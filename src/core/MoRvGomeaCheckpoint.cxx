@@ -16,10 +16,10 @@
 // inputs, parameters and mesh the front depends on), and what the payload
 // holds is checked against this run's mesh and options before any of it is
 // used.
-#include "morea/CheckpointWriter.h"
-#include "morea/Error.h"
-#include "morea/Hash.h"
-#include "morea/MoRvGomea.h"
+#include "morea_core/CheckpointWriter.h"
+#include "morea_core/Error.h"
+#include "morea_core/Hash.h"
+#include "morea_core/MoRvGomea.h"
 
 #include <algorithm>
 #include <cmath>
@@ -33,7 +33,7 @@
 #include <set>
 #include <string>
 
-namespace morea
+namespace morea_core
 {
 namespace
 {
@@ -524,4 +524,4 @@ MoRvGomea::LoadCheckpoint(const std::string & path)
     throw NamingFile(e, path);
   }
 }
-} // namespace morea
+} // namespace morea_core

@@ -5,15 +5,15 @@
 // with their adaptive multipliers.
 #include "MoRvGomeaParts.h"
 
-#include "morea/Error.h"
-#include "morea/ThreadPool.h"
+#include "morea_core/Error.h"
+#include "morea_core/ThreadPool.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numeric>
 
-namespace morea
+namespace morea_core
 {
 namespace
 {
@@ -464,4 +464,4 @@ MoRvGomea::UpdateDistributionStates(const std::vector<ClusterModel> &           
     }
   }
 }
-} // namespace morea
+} // namespace morea_core

@@ -7,13 +7,13 @@
 #ifndef morea_MoRvGomeaParts_h
 #define morea_MoRvGomeaParts_h
 
-#include "morea/MoRvGomea.h"
+#include "morea_core/MoRvGomea.h"
 
 #include <chrono>
 #include <cstdint>
 #include <vector>
 
-namespace morea
+namespace morea_core
 {
 // Generations without improvement tolerated: 25 + the number of variables
 // (per distribution; per solution that of an edge element, 12).
@@ -152,6 +152,6 @@ struct MoRvGomea::CandidateBatch
     return values.data() + c.firstValue;
   }
 };
-} // namespace morea
+} // namespace morea_core
 
 #endif

@@ -1,15 +1,15 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/NearContourBlocks.h"
+#include "morea_core/NearContourBlocks.h"
 
-#include "morea/Error.h"
-#include "morea/ObjectiveData.h"
+#include "morea_core/Error.h"
+#include "morea_core/ObjectiveData.h"
 
 #include <algorithm>
 #include <limits>
 #include <string>
 
-namespace morea
+namespace morea_core
 {
 NearContourBlocks
 FindNearContourBlocks(const ChannelVolume & volume, double radius)
@@ -55,4 +55,4 @@ FindNearContourBlocks(const ChannelVolume & volume, double radius)
       }
   return out;
 }
-} // namespace morea
+} // namespace morea_core

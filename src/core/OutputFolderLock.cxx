@@ -1,8 +1,8 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/OutputFolderLock.h"
+#include "morea_core/OutputFolderLock.h"
 
-#include "morea/Error.h"
+#include "morea_core/Error.h"
 
 #include <cerrno>
 #include <cstring>
@@ -13,7 +13,7 @@
 #include <sys/file.h>
 #include <unistd.h>
 
-namespace morea
+namespace morea_core
 {
 namespace
 {
@@ -69,4 +69,4 @@ OutputFolderLock::~OutputFolderLock()
   if (m_Descriptor >= 0)
     ::close(m_Descriptor); // releases the lock; the file stays (removing it would race a new owner)
 }
-} // namespace morea
+} // namespace morea_core

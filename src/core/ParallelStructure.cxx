@@ -1,14 +1,14 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/ParallelStructure.h"
+#include "morea_core/ParallelStructure.h"
 
-#include "morea/Error.h"
+#include "morea_core/Error.h"
 
 #include <algorithm>
 #include <set>
 #include <tuple>
 
-namespace morea
+namespace morea_core
 {
 std::vector<Edge>
 GreedyEdgeCover(const MeshTopology & topology)
@@ -179,4 +179,4 @@ BuildParallelStructure(const MeshTopology & topology)
   }
   return structure;
 }
-} // namespace morea
+} // namespace morea_core

@@ -1,8 +1,8 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/ParameterSet.h"
+#include "morea_core/ParameterSet.h"
 
-#include "morea/Error.h"
+#include "morea_core/Error.h"
 
 #include <toml++/toml.h>
 
@@ -14,7 +14,7 @@
 #include <limits>
 #include <sstream>
 
-namespace morea
+namespace morea_core
 {
 namespace
 {
@@ -565,4 +565,4 @@ ParseNamedValues(const std::string & text, const std::string & key)
   return result;
 }
 
-} // namespace morea
+} // namespace morea_core

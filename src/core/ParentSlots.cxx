@@ -1,12 +1,12 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/ParentSlots.h"
+#include "morea_core/ParentSlots.h"
 
-#include "morea/Error.h"
+#include "morea_core/Error.h"
 
 #include <algorithm>
 
-namespace morea
+namespace morea_core
 {
 ParentSlots::Assignment
 ParentSlots::AssignFirst(const std::vector<std::uint64_t> & keys, std::size_t total)
@@ -95,4 +95,4 @@ ParentSlots::Place(const std::vector<std::uint64_t> & keys, Assignment & out)
     out.upload.push_back(i);
   }
 }
-} // namespace morea
+} // namespace morea_core

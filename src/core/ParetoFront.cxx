@@ -1,8 +1,8 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/ParetoFront.h"
+#include "morea_core/ParetoFront.h"
 
-#include "morea/Error.h"
+#include "morea_core/Error.h"
 
 #include <algorithm>
 #include <array>
@@ -12,7 +12,7 @@
 #include <map>
 #include <numeric>
 
-namespace morea
+namespace morea_core
 {
 namespace
 {
@@ -409,4 +409,4 @@ SelectNearest(const std::vector<ObjectiveVector> & front, const ObjectiveVector 
   const ObjectiveVector target = normalise(point);
   return ArgMin(front.size(), [&](std::size_t i) { return SquaredDistance(normalise(front[i]), target); });
 }
-} // namespace morea
+} // namespace morea_core

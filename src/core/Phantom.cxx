@@ -1,9 +1,9 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/Phantom.h"
+#include "morea_core/Phantom.h"
 
-#include "morea/Error.h"
-#include "morea/Random.h"
+#include "morea_core/Error.h"
+#include "morea_core/Random.h"
 
 #include <algorithm>
 #include <cmath>
@@ -12,7 +12,7 @@
 #include <string>
 #include <thread>
 
-namespace morea
+namespace morea_core
 {
 namespace
 {
@@ -553,4 +553,4 @@ PelvisPhantom::SuiteLandmarks(std::vector<std::string> & kinds) const
           add({ { x, y, z } }, "soft");
   return points;
 }
-} // namespace morea
+} // namespace morea_core

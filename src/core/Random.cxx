@@ -1,10 +1,10 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/Random.h"
+#include "morea_core/Random.h"
 
 #include <cmath>
 
-namespace morea
+namespace morea_core
 {
 namespace
 {
@@ -89,4 +89,4 @@ HashCombine(std::uint64_t a, std::uint64_t b)
   x = SplitMix64(x) ^ b;
   return SplitMix64(x);
 }
-} // namespace morea
+} // namespace morea_core

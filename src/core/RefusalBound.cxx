@@ -1,12 +1,12 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/RefusalBound.h"
+#include "morea_core/RefusalBound.h"
 
-#include "morea/Error.h"
+#include "morea_core/Error.h"
 
 #include <cmath>
 
-namespace morea
+namespace morea_core
 {
 RefusalBoundChoice
 ParseRefusalBoundChoice(const std::string & name)
@@ -72,4 +72,4 @@ RefusedWhateverItsSamples(const RefusalBound & bound, const TetrahedronValues & 
     *entry = e;
   return true;
 }
-} // namespace morea
+} // namespace morea_core

@@ -1,15 +1,15 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/RigidityTerm.h"
+#include "morea_core/RigidityTerm.h"
 
-#include "morea/Error.h"
-#include "morea/ParameterSet.h"
+#include "morea_core/Error.h"
+#include "morea_core/ParameterSet.h"
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 
-namespace morea
+namespace morea_core
 {
 namespace
 {
@@ -195,4 +195,4 @@ SelectRigidStructures(const std::string & key, const std::vector<std::string> & 
   }
   return rigid;
 }
-} // namespace morea
+} // namespace morea_core

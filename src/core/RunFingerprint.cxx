@@ -1,16 +1,16 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/RunFingerprint.h"
+#include "morea_core/RunFingerprint.h"
 
-#include "morea/Hash.h"
-#include "morea/ParameterSet.h"
+#include "morea_core/Hash.h"
+#include "morea_core/ParameterSet.h"
 
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <iterator>
 
-namespace morea
+namespace morea_core
 {
 std::string
 ExactText(double value)
@@ -114,4 +114,4 @@ RunFingerprint::FirstDifference(const RunFingerprint & current) const
       return now.first + ": not in the checkpoint, " + Shown(now.second) + " in this run";
   return {};
 }
-} // namespace morea
+} // namespace morea_core

@@ -1,14 +1,14 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/SampleCosets.h"
+#include "morea_core/SampleCosets.h"
 
-#include "morea/Error.h"
-#include "morea/TetrahedronSampling.h"
+#include "morea_core/Error.h"
+#include "morea_core/TetrahedronSampling.h"
 
 #include <string>
 #include <vector>
 
-namespace morea
+namespace morea_core
 {
 namespace
 {
@@ -112,4 +112,4 @@ SobolStateOfOffset(std::uint32_t x, const std::uint32_t * directions)
         state[d] ^= directions[d * 32 + b];
   return state;
 }
-} // namespace morea
+} // namespace morea_core

@@ -1,14 +1,14 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/TetrahedralMesh.h"
+#include "morea_core/TetrahedralMesh.h"
 
-#include "morea/Error.h"
+#include "morea_core/Error.h"
 
 #include <algorithm>
 #include <cmath>
 #include <string>
 
-namespace morea
+namespace morea_core
 {
 MeshTopology::MeshTopology(const std::vector<Tetrahedron> & tetrahedra, std::size_t numberOfPoints)
   : m_Tetrahedra(tetrahedra)
@@ -139,4 +139,4 @@ PinOf(const Vec3 & p, const MeshDomain & domain, double tolerance)
   }
   return pin;
 }
-} // namespace morea
+} // namespace morea_core

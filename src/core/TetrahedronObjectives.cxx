@@ -1,14 +1,14 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/TetrahedronObjectives.h"
+#include "morea_core/TetrahedronObjectives.h"
 
-#include "morea/Error.h"
-#include "morea/MagnitudeObjective.h"
-#include "morea/TetrahedronSampling.h"
+#include "morea_core/Error.h"
+#include "morea_core/MagnitudeObjective.h"
+#include "morea_core/TetrahedronSampling.h"
 
 #include <cmath>
 
-namespace morea
+namespace morea_core
 {
 Fitness
 ObjectiveTotals::ToFitness(std::size_t numberOfTetrahedra) const
@@ -158,4 +158,4 @@ TetrahedronEvaluator::Evaluate(std::size_t t, const DualMesh & solution) const
   const Tetrahedron & tet = m_Topology->Tetrahedra()[t];
   return Evaluate(t, CornersOf(tet, solution.source), CornersOf(tet, solution.target));
 }
-} // namespace morea
+} // namespace morea_core

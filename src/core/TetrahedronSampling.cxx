@@ -1,12 +1,12 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/TetrahedronSampling.h"
+#include "morea_core/TetrahedronSampling.h"
 
-#include "morea/Random.h"
+#include "morea_core/Random.h"
 
 #include <cstring>
 
-namespace morea
+namespace morea_core
 {
 namespace
 {
@@ -100,4 +100,4 @@ TetrahedronSeed(const Vec3 & a, const Vec3 & b, const Vec3 & c, const Vec3 & d)
     }
   return h;
 }
-} // namespace morea
+} // namespace morea_core

@@ -1,8 +1,8 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/ThreadPool.h"
+#include "morea_core/ThreadPool.h"
 
-#include "morea/Error.h"
+#include "morea_core/Error.h"
 
 #include <algorithm>
 #include <chrono>
@@ -20,7 +20,7 @@
 #  include <unistd.h>
 #endif
 
-namespace morea
+namespace morea_core
 {
 namespace
 {
@@ -345,4 +345,4 @@ BackgroundWorker::Loop(WorkerPriority priority)
     m_Changed.notify_all();
   }
 }
-} // namespace morea
+} // namespace morea_core

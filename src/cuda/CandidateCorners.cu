@@ -11,7 +11,7 @@
 
 #include <cstdint>
 
-namespace morea::cuda
+namespace morea_core::cuda
 {
 namespace
 {
@@ -146,4 +146,4 @@ LaunchScatterParents(const double * staged, const std::uint32_t * slots, std::si
                                                                                   store);
   Check(cudaGetLastError(), "launching the parent scatter kernel");
 }
-} // namespace morea::cuda
+} // namespace morea_core::cuda

@@ -10,7 +10,7 @@
 
 #include <cstdint>
 
-namespace morea::cuda
+namespace morea_core::cuda
 {
 namespace
 {
@@ -74,4 +74,4 @@ LaunchSumCandidateValues(const CandidateBatch & batch, const double * itemValues
                                                                                  directionValues, sums);
   Check(cudaGetLastError(), "launching the candidate sum kernel");
 }
-} // namespace morea::cuda
+} // namespace morea_core::cuda

@@ -5,7 +5,7 @@
 // handed back as each part ends.
 #include "CudaEvaluationBackend.h"
 
-namespace morea
+namespace morea_core
 {
 namespace cudabackend
 {
@@ -494,4 +494,4 @@ CudaEvaluationBackend::UnpackSums(const std::vector<PartialCandidate> & candidat
   return itemsLeftAlone;
 }
 } // namespace cudabackend
-} // namespace morea
+} // namespace morea_core

@@ -9,7 +9,7 @@
 #include <cmath>
 #include <limits>
 
-namespace morea
+namespace morea_core
 {
 namespace cudabackend
 {
@@ -564,4 +564,4 @@ CudaEvaluationBackend::QueueRange(const std::vector<PartialCandidate> & candidat
   f.sampledParts = f.Parts();
 }
 } // namespace cudabackend
-} // namespace morea
+} // namespace morea_core

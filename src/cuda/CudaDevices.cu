@@ -1,11 +1,11 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
 // Device discovery through the CUDA runtime. No ITK here.
-#include "morea/ComputeDevices.h"
+#include "morea_core/ComputeDevices.h"
 
 #include <cuda_runtime.h>
 
-namespace morea
+namespace morea_core
 {
 bool
 BuiltWithCuda()
@@ -86,4 +86,4 @@ CudaFreeMemory(int device)
   cudaSetDevice(current);
   return free;
 }
-} // namespace morea
+} // namespace morea_core

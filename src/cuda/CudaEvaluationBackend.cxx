@@ -4,7 +4,7 @@
 // CudaEvaluationBackend.h).
 #include "CudaEvaluationBackend.h"
 
-namespace morea
+namespace morea_core
 {
 namespace cudabackend
 {
@@ -514,4 +514,4 @@ CreateCudaEvaluationBackend(const TetrahedronEvaluator & evaluator, std::size_t 
 {
   return std::make_unique<cudabackend::CudaEvaluationBackend>(evaluator, threads, interpolation, device);
 }
-} // namespace morea
+} // namespace morea_core

@@ -17,19 +17,19 @@
 #ifndef morea_CudaEvaluationBackend_h
 #define morea_CudaEvaluationBackend_h
 
-#include "morea/EvaluationBackend.h"
+#include "morea_core/EvaluationBackend.h"
 
 #include "DeviceMemory.h"
 #include "FoldRepairKernels.h"
 #include "RefusalScreenKernels.h"
 #include "TetrahedronKernels.h"
 
-#include "morea/ComputeDevices.h"
-#include "morea/NearContourBlocks.h"
-#include "morea/ParentSlots.h"
-#include "morea/Error.h"
-#include "morea/TetrahedronSampling.h"
-#include "morea/ThreadPool.h"
+#include "morea_core/ComputeDevices.h"
+#include "morea_core/NearContourBlocks.h"
+#include "morea_core/ParentSlots.h"
+#include "morea_core/Error.h"
+#include "morea_core/TetrahedronSampling.h"
+#include "morea_core/ThreadPool.h"
 
 #include <algorithm>
 #include <array>
@@ -42,7 +42,7 @@
 #include <unordered_map>
 #include <vector>
 
-namespace morea
+namespace morea_core
 {
 namespace cudabackend
 {
@@ -757,6 +757,6 @@ private:
   cuda::PinnedArray<double>                    m_HostFallbackDirectionValues;
 };
 } // namespace cudabackend
-} // namespace morea
+} // namespace morea_core
 
 #endif

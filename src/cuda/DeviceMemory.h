@@ -6,7 +6,7 @@
 #ifndef morea_cuda_DeviceMemory_h
 #define morea_cuda_DeviceMemory_h
 
-#include "morea/Error.h"
+#include "morea_core/Error.h"
 
 #include <cuda_runtime.h>
 
@@ -14,10 +14,10 @@
 #include <cstddef>
 #include <string>
 
-namespace morea::cuda
+namespace morea_core::cuda
 {
-/** Throws morea::Error naming `what` when `status` is not cudaSuccess
- *  (morea::OutOfDeviceMemory when the device's memory is spent). */
+/** Throws morea_core::Error naming `what` when `status` is not cudaSuccess
+ *  (morea_core::OutOfDeviceMemory when the device's memory is spent). */
 inline void
 Check(cudaError_t status, const char * what)
 {
@@ -240,6 +240,6 @@ public:
 private:
   cudaEvent_t m_Event{ nullptr };
 };
-} // namespace morea::cuda
+} // namespace morea_core::cuda
 
 #endif

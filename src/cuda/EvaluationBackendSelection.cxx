@@ -1,13 +1,13 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
 // The one place that chooses between the CPU and CUDA evaluation backends.
-#include "morea/ComputeDevices.h"
-#include "morea/Error.h"
-#include "morea/EvaluationBackend.h"
+#include "morea_core/ComputeDevices.h"
+#include "morea_core/Error.h"
+#include "morea_core/EvaluationBackend.h"
 
 #include <string>
 
-namespace morea
+namespace morea_core
 {
 namespace
 {
@@ -146,4 +146,4 @@ CreateEvaluationBackend(const BackendRequest & request, const TetrahedronEvaluat
   }
   return backend;
 }
-} // namespace morea
+} // namespace morea_core

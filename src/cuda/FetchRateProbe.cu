@@ -3,14 +3,14 @@
 // A yardstick for the tetrahedron kernels: how many hardware-filtered
 // trilinear fetches per second the GPU serves from a 3D float texture when
 // neighbouring threads read neighbouring points (the coherent best case).
-#include "morea/ComputeDevices.h"
+#include "morea_core/ComputeDevices.h"
 
 #include "DeviceMemory.h"
 
 #include <algorithm>
 #include <vector>
 
-namespace morea
+namespace morea_core
 {
 namespace
 {
@@ -121,4 +121,4 @@ CudaMemoryInUse()
   }
   return total - free;
 }
-} // namespace morea
+} // namespace morea_core

@@ -11,12 +11,12 @@
 #include "DeviceMemory.h"
 #include "TetrahedronDevice.cuh"
 
-#include "morea/RepairNoise.h"
-#include "morea/RepairStar.h"
+#include "morea_core/RepairNoise.h"
+#include "morea_core/RepairStar.h"
 
 #include <cstdint>
 
-namespace morea::cuda
+namespace morea_core::cuda
 {
 namespace
 {
@@ -528,4 +528,4 @@ LaunchCheckCandidateFolds(const CandidateBatch & batch, const FoldRepairConstant
     batch, constants, check, sideSeeds, moved, outcome, first, count);
   Check(cudaGetLastError(), "launching the fold check kernel");
 }
-} // namespace morea::cuda
+} // namespace morea_core::cuda

@@ -10,7 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 
-namespace morea::cuda
+namespace morea_core::cuda
 {
 /** The fold constraint and the repair's fixed data on the device. */
 struct FoldRepairConstants
@@ -45,6 +45,6 @@ void
 LaunchCheckCandidateFolds(const CandidateBatch & batch, const FoldRepairConstants & constants,
                           const std::uint8_t * check, const std::uint64_t * sideSeeds, double * moved,
                           std::uint8_t * outcome, std::size_t first, std::size_t count, void * stream);
-} // namespace morea::cuda
+} // namespace morea_core::cuda
 
 #endif

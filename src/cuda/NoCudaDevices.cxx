@@ -1,11 +1,11 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
 // CPU-only builds: there is no CUDA backend to offer.
-#include "morea/ComputeDevices.h"
-#include "morea/Error.h"
-#include "morea/EvaluationBackend.h"
+#include "morea_core/ComputeDevices.h"
+#include "morea_core/Error.h"
+#include "morea_core/EvaluationBackend.h"
 
-namespace morea
+namespace morea_core
 {
 bool
 BuiltWithCuda()
@@ -52,4 +52,4 @@ CreateCudaEvaluationBackend(const TetrahedronEvaluator &, std::size_t, CudaInter
 {
   throw Error("CUDA backend: " + CudaUnavailableReason());
 }
-} // namespace morea
+} // namespace morea_core

@@ -11,7 +11,7 @@
 
 #include <cstdint>
 
-namespace morea::cuda
+namespace morea_core::cuda
 {
 namespace
 {
@@ -27,8 +27,8 @@ WarpTotal(double x)
   return x;
 }
 
-/** The bound's fitness, steered (morea::BoundFitness), and whether the
- *  candidate is refused whatever its samples (morea::RefusedWhateverItsSamples)
+/** The bound's fitness, steered (morea_core::BoundFitness), and whether the
+ *  candidate is refused whatever its samples (morea_core::RefusedWhateverItsSamples)
  *  but for the archive, which the caller scans when `scan` comes back true. */
 __device__ bool
 RefusedBeforeArchive(const CandidateBoundInput & b, const RefusalScreenView & screen, const double corners[4],
@@ -179,4 +179,4 @@ LaunchGatherItems(const double * corners, const std::uint32_t * tetrahedra, cons
                                                                       outTetrahedra);
   Check(cudaGetLastError(), "launching the item gather");
 }
-} // namespace morea::cuda
+} // namespace morea_core::cuda

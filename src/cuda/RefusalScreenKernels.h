@@ -1,7 +1,7 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
 // Launchers of the refusal screen (morea/RefusalBound.h) on the device, in
-// plain C++ types: the rule of morea::RefusedWhateverItsSamples applied to
+// plain C++ types: the rule of morea_core::RefusedWhateverItsSamples applied to
 // every candidate of a batch once its corners are built, and the gathering
 // of skipped candidates' items when the optimiser needs them sampled.
 #ifndef morea_cuda_RefusalScreenKernels_h
@@ -12,9 +12,9 @@
 #include <cstddef>
 #include <cstdint>
 
-namespace morea::cuda
+namespace morea_core::cuda
 {
-/** One candidate's bound (morea::RefusalBound) as the screen reads it. */
+/** One candidate's bound (morea_core::RefusalBound) as the screen reads it. */
 struct CandidateBoundInput
 {
   double        rest[6];   ///< the parent's totals less the element's tetrahedra:
@@ -35,7 +35,7 @@ struct RefusalScreenView
   std::uint32_t               archiveSize{ 0 };
   double                      tetrahedra{ 0.0 };
   double                      guidanceLimit{ 0.0 }; ///< may be infinite
-  double                      foldOffset{ 0.0 };    ///< morea::FoldConstraintOffset
+  double                      foldOffset{ 0.0 };    ///< morea_core::FoldConstraintOffset
 };
 
 /** For every candidate of `batch` whose items `corners` and `tetrahedra` hold
@@ -54,6 +54,6 @@ LaunchScreenCandidates(const EvaluationConstants & constants, const CandidateBat
 void
 LaunchGatherItems(const double * corners, const std::uint32_t * tetrahedra, const std::uint64_t * items,
                   std::size_t count, double * outCorners, std::uint32_t * outTetrahedra, void * stream);
-} // namespace morea::cuda
+} // namespace morea_core::cuda
 
 #endif

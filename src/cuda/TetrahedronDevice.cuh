@@ -8,7 +8,7 @@
 
 #include <cstdint>
 
-namespace morea::cuda::device
+namespace morea_core::cuda::device
 {
 inline __device__ std::uint64_t
 SplitMix64(std::uint64_t & x)
@@ -274,6 +274,6 @@ WriteItemValues(const double * referenceVolumes, double volumeFraction, const do
   out[1] = value;
   out[2] = folded;
 }
-} // namespace morea::cuda::device
+} // namespace morea_core::cuda::device
 
 #endif

@@ -13,7 +13,7 @@
 
 #include <cstdint>
 
-namespace morea::cuda
+namespace morea_core::cuda
 {
 namespace
 {
@@ -276,4 +276,4 @@ LaunchEvaluateTetrahedra(const EvaluationConstants & constants, const double * c
       k, k.packedMoving, k.packedFixed, corners, tetrahedra, itemSkip, items, itemOut, directionOut);
   Check(cudaGetLastError(), "launching the tetrahedron kernel");
 }
-} // namespace morea::cuda
+} // namespace morea_core::cuda

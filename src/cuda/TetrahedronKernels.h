@@ -8,7 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 
-namespace morea::cuda
+namespace morea_core::cuda
 {
 /** A multi-channel volume in device memory, channels interleaved per voxel. */
 struct VolumeView
@@ -95,7 +95,7 @@ struct PackedVolumeView
 };
 
 /** Edge of PackedVolumeView::nearBlocks' blocks, in texels
- *  (morea::NearContourBlocks::BlockSize). */
+ *  (morea_core::NearContourBlocks::BlockSize). */
 constexpr int NearBlockSize = 4;
 
 /** Everything a tetrahedron's evaluation reads besides its corners. */
@@ -307,6 +307,6 @@ LaunchSampleListedChunks(const EvaluationConstants & constants, const double * c
 /** Copies the Sobol direction numbers to the texture kernels' module. */
 void
 UploadTextureSobolDirections(const std::uint32_t * directions);
-} // namespace morea::cuda
+} // namespace morea_core::cuda
 
 #endif

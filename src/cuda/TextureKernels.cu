@@ -22,7 +22,7 @@
 #include "DeviceMemory.h"
 #include "TetrahedronDevice.cuh"
 
-#include "morea/SampleCosets.h"
+#include "morea_core/SampleCosets.h"
 
 #include <cub/device/device_radix_sort.cuh>
 #include <cub/device/device_scan.cuh>
@@ -32,7 +32,7 @@
 #include <cstdint>
 #include <type_traits>
 
-namespace morea::cuda
+namespace morea_core::cuda
 {
 namespace
 {
@@ -390,7 +390,7 @@ constexpr int SlotMaskBits = NearBlockBits(Slots);
  *  (PackedVolumeView::nearBlocks, MaskBits bits per block: bit g for
  *  structure g). The block of the footprint's first texel floor(p - 1/2),
  *  along z floor(s - 1), clamped as the texture clamps: the rule of
- *  morea::NearContourBlocks::BlockOf, in texel coordinates. */
+ *  morea_core::NearContourBlocks::BlockOf, in texel coordinates. */
 template <int MaskBits>
 __device__ unsigned
 NearStructures(const std::uint8_t * __restrict__ nearBlocks, const int blocks[3], const float p[3])
@@ -1016,4 +1016,4 @@ LaunchSampleListedChunks(const EvaluationConstants & constants, const double * c
   });
   Check(cudaGetLastError(), "launching the listed chunks' sampling");
 }
-} // namespace morea::cuda
+} // namespace morea_core::cuda

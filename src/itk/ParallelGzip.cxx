@@ -3,7 +3,7 @@
 #include "ParallelGzip.h"
 
 #include "itkMacro.h"
-#include "morea/ParallelForThreads.h"
+#include "morea_core/ParallelForThreads.h"
 
 #include <zlib.h>
 
@@ -97,7 +97,7 @@ GzipFileInChunks(const std::string & from, const std::string & to, std::size_t c
 
   const std::size_t  chunks = std::max<std::size_t>(1, (data.size() + chunkBytes - 1) / chunkBytes);
   std::vector<Piece> pieces(chunks);
-  ::morea::ParallelForOnNewThreads(chunks, [&](std::size_t i) {
+  morea_core::ParallelForOnNewThreads(chunks, [&](std::size_t i) {
     const std::size_t begin = i * chunkBytes;
     pieces[i] = DeflatePiece(data.data(), begin, std::min(data.size(), begin + chunkBytes), i + 1 == chunks);
   });

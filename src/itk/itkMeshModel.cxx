@@ -4,11 +4,11 @@
 
 #include "itkMOREAImageIO.h"
 #include "itkPreprocessing.h"
-#include "morea/ElasticityFactors.h"
-#include "morea/MeshRefinement.h"
-#include "morea/Error.h"
-#include "morea/ParameterSet.h"
-#include "morea/RigidityTerm.h"
+#include "morea_core/ElasticityFactors.h"
+#include "morea_core/MeshRefinement.h"
+#include "morea_core/Error.h"
+#include "morea_core/ParameterSet.h"
+#include "morea_core/RigidityTerm.h"
 
 #include <algorithm>
 #include <cctype>
@@ -41,14 +41,14 @@ namespace
 /** The rigid structures with a moving mask (morea_rigid_structures; none when
  *  morea_rigid_weight is 0); `notes` tells of those without one. */
 std::vector<std::string>
-RigidStructureNames(const RegistrationProblem & problem, const ::morea::ParameterSet & parameters,
+RigidStructureNames(const RegistrationProblem & problem, const morea_core::ParameterSet & parameters,
                     std::vector<std::string> & notes)
 {
   std::vector<std::string> names, available;
   for (const Structure & s : problem.structures)
     available.push_back(s.name);
-  const auto factors = ::morea::ParseElasticityFactors(parameters.GetString("morea_elasticity_factors"));
-  const auto rigid = ::morea::SelectRigidStructures(parameters.GetString("morea_rigid_structures"), available, factors);
+  const auto factors = morea_core::ParseElasticityFactors(parameters.GetString("morea_elasticity_factors"));
+  const auto rigid = morea_core::SelectRigidStructures(parameters.GetString("morea_rigid_structures"), available, factors);
   if (parameters.GetReal("morea_rigid_weight") == 0.0)
     return names;
   for (const std::string & name : rigid)
@@ -63,20 +63,20 @@ RigidStructureNames(const RegistrationProblem & problem, const ::morea::Paramete
 /** What follows from the base mesh: topology, parallel structure,
  *  elasticity factors and the rigidity model. */
 void
-DeriveMeshModelParts(const RegistrationProblem & problem, const ::morea::ParameterSet & parameters, MeshModel & model)
+DeriveMeshModelParts(const RegistrationProblem & problem, const morea_core::ParameterSet & parameters, MeshModel & model)
 {
   auto start = Clock::now();
-  model.topology = ::morea::MeshTopology(model.base.tetrahedra, model.base.NumberOfPoints());
-  model.parallel = ::morea::BuildParallelStructure(model.topology);
+  model.topology = morea_core::MeshTopology(model.base.tetrahedra, model.base.NumberOfPoints());
+  model.parallel = morea_core::BuildParallelStructure(model.topology);
   model.report.fosElements = model.parallel.elements.size();
   model.report.parallelGroups = model.parallel.groups.size();
   model.report.secondsParallelStructure = SecondsSince(start);
 
   // Elasticity from all structures with a factor, guidance or not (bones, say).
   start = Clock::now();
-  std::vector<::morea::ElasticStructure>     elastic;
-  std::vector<::morea::Volume<std::uint8_t>> elasticMasks;
-  const auto factors = ::morea::ParseElasticityFactors(parameters.GetString("morea_elasticity_factors"));
+  std::vector<morea_core::ElasticStructure>     elastic;
+  std::vector<morea_core::Volume<std::uint8_t>> elasticMasks;
+  const auto factors = morea_core::ParseElasticityFactors(parameters.GetString("morea_elasticity_factors"));
   if (parameters.GetString("morea_magnitude_metric") == "biomechanical")
   {
     elasticMasks.reserve(factors.size());
@@ -92,11 +92,11 @@ DeriveMeshModelParts(const RegistrationProblem & problem, const ::morea::Paramet
       elastic.push_back({ name, &elasticMasks.back(), factor });
     }
   }
-  model.elasticity = ::morea::ComputeElasticityFactors(model.base, elastic);
+  model.elasticity = morea_core::ComputeElasticityFactors(model.base, elastic);
 
   // Rigid structures, guidance or not: the tetrahedra inside their masks.
-  std::vector<::morea::Volume<std::uint8_t>>         rigidMasks;
-  std::vector<const ::morea::Volume<std::uint8_t> *> rigidMaskPointers;
+  std::vector<morea_core::Volume<std::uint8_t>>         rigidMasks;
+  std::vector<const morea_core::Volume<std::uint8_t> *> rigidMaskPointers;
   rigidMasks.reserve(model.rigidStructureNames.size());
   for (const std::string & name : model.rigidStructureNames)
   {
@@ -104,7 +104,7 @@ DeriveMeshModelParts(const RegistrationProblem & problem, const ::morea::Paramet
     rigidMaskPointers.push_back(&rigidMasks.back());
   }
   if (!rigidMaskPointers.empty())
-    model.rigidity = ::morea::BuildRigidityModel(model.base, ::morea::UnionOverlapFractions(model.base, rigidMaskPointers),
+    model.rigidity = morea_core::BuildRigidityModel(model.base, morea_core::UnionOverlapFractions(model.base, rigidMaskPointers),
                                                  parameters.GetReal("morea_rigid_weight"),
                                                  parameters.GetReal("morea_rigid_strain_limit"));
   model.report.secondsElasticity = SecondsSince(start);
@@ -112,7 +112,7 @@ DeriveMeshModelParts(const RegistrationProblem & problem, const ::morea::Paramet
 } // namespace
 
 std::vector<std::string>
-GuidanceStructureNames(const RegistrationProblem & problem, const ::morea::ParameterSet & parameters)
+GuidanceStructureNames(const RegistrationProblem & problem, const morea_core::ParameterSet & parameters)
 {
   const std::string &      selection = parameters.GetString("problem_guidance_selection");
   std::vector<std::string> names;
@@ -123,7 +123,7 @@ GuidanceStructureNames(const RegistrationProblem & problem, const ::morea::Param
         names.push_back(s.name);
     return names;
   }
-  for (const std::string & name : ::morea::ParseNameList(selection))
+  for (const std::string & name : morea_core::ParseNameList(selection))
   {
     problem.GetStructure(name); // throws, listing the known names
     names.push_back(name);
@@ -132,7 +132,7 @@ GuidanceStructureNames(const RegistrationProblem & problem, const ::morea::Param
 }
 
 MeshModel
-BuildMeshModel(const RegistrationProblem & problem, const ::morea::ParameterSet & parameters)
+BuildMeshModel(const RegistrationProblem & problem, const morea_core::ParameterSet & parameters)
 {
   if (!problem.movingImage || !problem.fixedImage)
     itkGenericExceptionMacro("mesh model: the problem has no images");
@@ -140,21 +140,21 @@ BuildMeshModel(const RegistrationProblem & problem, const ::morea::ParameterSet 
     itkGenericExceptionMacro("mesh model: the problem must be preprocessed (both images on one grid)");
   MeshModel model;
   model.frame = DomainFrame::Of(problem.movingImage);
-  const ::morea::MeshDomain domain = ::morea::MeshDomain::OfGrid(model.frame.GeometryOf(problem.movingImage));
+  const morea_core::MeshDomain domain = morea_core::MeshDomain::OfGrid(model.frame.GeometryOf(problem.movingImage));
 
   // The mesh lies on the moving (source) image: its structures' contours and
   // masks. Rigid structures that do not guide get contour points too, so
   // that tetrahedra can lie inside a bone and stay rigid while those beside
   // it deform.
   auto                                       start = Clock::now();
-  std::vector<::morea::Volume<std::uint8_t>> masks;
-  std::vector<::morea::MeshStructure>        structures;
+  std::vector<morea_core::Volume<std::uint8_t>> masks;
+  std::vector<morea_core::MeshStructure>        structures;
   std::vector<std::string>                   rigidNotes;
   try
   {
     model.rigidStructureNames = RigidStructureNames(problem, parameters, rigidNotes);
   }
-  catch (const ::morea::Error & e)
+  catch (const morea_core::Error & e)
   {
     itkGenericExceptionMacro("mesh model: " << e.what());
   }
@@ -166,7 +166,7 @@ BuildMeshModel(const RegistrationProblem & problem, const ::morea::ParameterSet 
   for (const std::string & name : model.structureNames)
   {
     const Structure & s = problem.GetStructure(name);
-    ::morea::MeshStructure m;
+    morea_core::MeshStructure m;
     m.name = name;
     PointListType points = s.movingPoints;
     if (points.empty() && s.movingMask)
@@ -184,14 +184,14 @@ BuildMeshModel(const RegistrationProblem & problem, const ::morea::ParameterSet 
 
   try
   {
-    const auto options = ::morea::MeshGeneratorOptions::FromParameters(parameters);
-    model.base = ::morea::GenerateMesh(domain, structures, options, &model.report.generation);
+    const auto options = morea_core::MeshGeneratorOptions::FromParameters(parameters);
+    model.base = morea_core::GenerateMesh(domain, structures, options, &model.report.generation);
     model.report.notes = model.report.generation.notes;
     model.report.notes.insert(model.report.notes.end(), rigidNotes.begin(), rigidNotes.end());
 
     DeriveMeshModelParts(problem, parameters, model);
   }
-  catch (const ::morea::Error & e)
+  catch (const morea_core::Error & e)
   {
     itkGenericExceptionMacro("mesh model: " << e.what());
   }
@@ -199,8 +199,8 @@ BuildMeshModel(const RegistrationProblem & problem, const ::morea::ParameterSet 
 }
 
 MeshModel
-RefineMeshModel(const MeshModel & coarse, const RegistrationProblem & problem, const ::morea::ParameterSet & parameters,
-                const std::vector<double> & density, std::size_t targetPoints, ::morea::MeshRefinement & refinement)
+RefineMeshModel(const MeshModel & coarse, const RegistrationProblem & problem, const morea_core::ParameterSet & parameters,
+                const std::vector<double> & density, std::size_t targetPoints, morea_core::MeshRefinement & refinement)
 {
   MeshModel model;
   model.frame = coarse.frame;
@@ -208,7 +208,7 @@ RefineMeshModel(const MeshModel & coarse, const RegistrationProblem & problem, c
   model.structureNames = coarse.structureNames;
   try
   {
-    refinement = ::morea::RefineMesh(coarse.base, density, targetPoints);
+    refinement = morea_core::RefineMesh(coarse.base, density, targetPoints);
     model.base = refinement.mesh;
     model.report.generation = coarse.report.generation;
     model.report.notes = coarse.report.notes;
@@ -217,7 +217,7 @@ RefineMeshModel(const MeshModel & coarse, const RegistrationProblem & problem, c
     model.report.generation.slivers = 0;
     for (const auto & t : model.base.tetrahedra)
     {
-      const double q = ::morea::TetrahedronQuality(model.base.points[t[0]], model.base.points[t[1]],
+      const double q = morea_core::TetrahedronQuality(model.base.points[t[0]], model.base.points[t[1]],
                                                    model.base.points[t[2]], model.base.points[t[3]]);
       model.report.generation.worstQuality = std::min(model.report.generation.worstQuality, q);
       model.report.generation.slivers += q < 0.05 ? 1 : 0;
@@ -226,7 +226,7 @@ RefineMeshModel(const MeshModel & coarse, const RegistrationProblem & problem, c
                                  std::to_string(model.base.NumberOfPoints()) + " points");
     DeriveMeshModelParts(problem, parameters, model);
   }
-  catch (const ::morea::Error & e)
+  catch (const morea_core::Error & e)
   {
     itkGenericExceptionMacro("mesh model: " << e.what());
   }
@@ -234,7 +234,7 @@ RefineMeshModel(const MeshModel & coarse, const RegistrationProblem & problem, c
 }
 
 void
-WriteSolutionMeshes(const MeshModel & model, const ::morea::DualMesh & solution, const std::string & movingPath,
+WriteSolutionMeshes(const MeshModel & model, const morea_core::DualMesh & solution, const std::string & movingPath,
                     const std::string & fixedPath)
 {
   std::vector<double> origin, structure;
@@ -243,13 +243,13 @@ WriteSolutionMeshes(const MeshModel & model, const ::morea::DualMesh & solution,
     origin.push_back(static_cast<double>(model.base.origins[p]));
     structure.push_back(static_cast<double>(model.base.structures[p]));
   }
-  const std::vector<::morea::VtuArray> pointData{ { "origin", origin }, { "structure", structure } };
+  const std::vector<morea_core::VtuArray> pointData{ { "origin", origin }, { "structure", structure } };
   for (const auto & [points, path] : { std::make_pair(&solution.source, movingPath),
                                       std::make_pair(&solution.target, fixedPath) })
   {
     std::vector<double> volume;
     for (const auto & t : model.topology.Tetrahedra())
-      volume.push_back(::morea::SignedVolume(t, *points));
+      volume.push_back(morea_core::SignedVolume(t, *points));
     const std::vector<double> rigidity =
       model.rigidity.Empty() ? std::vector<double>(model.topology.NumberOfTetrahedra(), 0.0) : model.rigidity.weights;
     WriteMeshVtu(path, model.topology, *points, model.frame,

@@ -3,15 +3,15 @@
 #include "itkMeshRegistration.h"
 
 #include "itkObjectiveData.h"
-#include "morea/CheckpointWriter.h"
-#include "morea/Error.h"
-#include "morea/EvaluationBackend.h"
-#include "morea/FoldConstraint.h"
-#include "morea/InitialPopulation.h"
-#include "morea/MemoryEstimate.h"
-#include "morea/MeshRefinement.h"
-#include "morea/ParameterSet.h"
-#include "morea/TetrahedronObjectives.h"
+#include "morea_core/CheckpointWriter.h"
+#include "morea_core/Error.h"
+#include "morea_core/EvaluationBackend.h"
+#include "morea_core/FoldConstraint.h"
+#include "morea_core/InitialPopulation.h"
+#include "morea_core/MemoryEstimate.h"
+#include "morea_core/MeshRefinement.h"
+#include "morea_core/ParameterSet.h"
+#include "morea_core/TetrahedronObjectives.h"
 
 #include <algorithm>
 #include <chrono>
@@ -33,14 +33,14 @@ Numbers(const double * values, unsigned int count)
 {
   std::string text;
   for (unsigned int i = 0; i < count; ++i)
-    text += (i ? " " : "") + ::morea::ExactText(values[i]);
+    text += (i ? " " : "") + morea_core::ExactText(values[i]);
   return text;
 }
 
 /** An image's grid as text, and its voxels' hash, under `name`. */
 template <typename TImage>
 void
-AddImage(::morea::RunFingerprint & fingerprint, const std::string & name, const TImage * image)
+AddImage(morea_core::RunFingerprint & fingerprint, const std::string & name, const TImage * image)
 {
   if (!image)
   {
@@ -62,7 +62,7 @@ AddImage(::morea::RunFingerprint & fingerprint, const std::string & name, const 
 }
 
 void
-AddPoints(::morea::RunFingerprint & fingerprint, const std::string & name, const PointListType & points)
+AddPoints(morea_core::RunFingerprint & fingerprint, const std::string & name, const PointListType & points)
 {
   std::vector<double> coordinates;
   for (const PointType & p : points)
@@ -71,10 +71,10 @@ AddPoints(::morea::RunFingerprint & fingerprint, const std::string & name, const
 }
 } // namespace
 
-::morea::RunFingerprint
-RunFingerprintOf(const RegistrationProblem & problem, const ::morea::ParameterSet & parameters)
+morea_core::RunFingerprint
+RunFingerprintOf(const RegistrationProblem & problem, const morea_core::ParameterSet & parameters)
 {
-  ::morea::RunFingerprint fingerprint;
+  morea_core::RunFingerprint fingerprint;
   fingerprint.AddParameters(parameters);
   AddImage(fingerprint, "fixed image", problem.fixedImage.GetPointer());
   AddImage(fingerprint, "moving image", problem.movingImage.GetPointer());
@@ -99,7 +99,7 @@ namespace
 /** Level `level`'s checkpoint file: the run's own for the last level (or
  *  the only one), beside it with ".levelK" for earlier ones. */
 std::string
-LevelCheckpointPath(const std::string & path, std::size_t level, const ::morea::MeshLevelPlan & plan)
+LevelCheckpointPath(const std::string & path, std::size_t level, const morea_core::MeshLevelPlan & plan)
 {
   if (path.empty() || level + 1 == plan.levels)
     return path;
@@ -109,18 +109,18 @@ LevelCheckpointPath(const std::string & path, std::size_t level, const ::morea::
 /** Per coarse tetrahedron, where the next level needs points: from up to 16
  *  archived solutions spread along the front (by guidance). */
 std::vector<double>
-NextLevelDensity(const MeshModel & model, const ::morea::ElitistArchive & archive, ::morea::EvaluationBackend & backend)
+NextLevelDensity(const MeshModel & model, const morea_core::ElitistArchive & archive, morea_core::EvaluationBackend & backend)
 {
-  std::vector<const ::morea::ArchiveEntry *> entries;
+  std::vector<const morea_core::ArchiveEntry *> entries;
   for (const auto & e : archive.Entries())
     entries.push_back(&e);
   std::stable_sort(entries.begin(), entries.end(), [](const auto * a, const auto * b) {
     return a->fitness.objectives[2] < b->fitness.objectives[2];
   });
   const std::size_t                                    count = std::min<std::size_t>(16, entries.size());
-  std::vector<const ::morea::DualMesh *>               solutions;
-  std::vector<std::vector<::morea::TetrahedronValues>> values(count);
-  std::vector<std::vector<::morea::TetrahedronValues> *> outputs;
+  std::vector<const morea_core::DualMesh *>               solutions;
+  std::vector<std::vector<morea_core::TetrahedronValues>> values(count);
+  std::vector<std::vector<morea_core::TetrahedronValues> *> outputs;
   for (std::size_t i = 0; i < count; ++i)
   {
     solutions.push_back(&entries[i * entries.size() / count]->solution);
@@ -128,12 +128,12 @@ NextLevelDensity(const MeshModel & model, const ::morea::ElitistArchive & archiv
   }
   if (count > 0)
     backend.EvaluateSolutions(solutions, outputs);
-  return ::morea::RefinementDensity(model.base, values);
+  return morea_core::RefinementDensity(model.base, values);
 }
 } // namespace
 
 MeshRegistrationResult
-RegisterMeshes(const RegistrationProblem & problem, const ::morea::ParameterSet & parameters,
+RegisterMeshes(const RegistrationProblem & problem, const morea_core::ParameterSet & parameters,
                const MeshRegistrationOptions & options)
 {
   using Clock = std::chrono::steady_clock;
@@ -145,42 +145,42 @@ RegisterMeshes(const RegistrationProblem & problem, const ::morea::ParameterSet 
     return seconds;
   };
   MeshRegistrationResult result;
-  const ::morea::MeshLevelPlan plan = ::morea::MeshLevelPlan::FromParameters(parameters);
+  const morea_core::MeshLevelPlan plan = morea_core::MeshLevelPlan::FromParameters(parameters);
   // The objective data (distance maps) need the model's frame only: they are
   // made while the mesh is built (TetGen runs on one core). Without a moving
   // image there is no frame, and BuildMeshModel reports the missing images.
-  std::future<::morea::ObjectiveData> objectiveData;
+  std::future<morea_core::ObjectiveData> objectiveData;
   if (problem.movingImage)
     objectiveData = std::async(std::launch::async, [&problem, &parameters] {
       return BuildObjectiveData(problem, DomainFrame::Of(problem.movingImage), parameters);
     });
   MeshModel model = BuildMeshModel(problem, parameters);
   result.secondsMesh = lap();
-  const ::morea::ObjectiveData data = objectiveData.get();
+  const morea_core::ObjectiveData data = objectiveData.get();
   result.secondsObjectiveData = lap(); // what the mesh did not hide
   const std::size_t coarsePoints = model.base.NumberOfPoints();
 
-  ::morea::BackendRequest request;
+  morea_core::BackendRequest request;
   request.choice = options.backend;
   request.device = options.device;
   request.minimumComputeLevel = options.minimumComputeLevel;
   request.threads = options.threads;
   result.threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
 
-  ::morea::GomeaOptions baseOptions = ::morea::GomeaOptions::FromParameters(parameters);
+  morea_core::GomeaOptions baseOptions = morea_core::GomeaOptions::FromParameters(parameters);
   baseOptions.threads = options.threads; // the backend's pool: the two take turns on it
   // What a checkpoint belongs to: the caller's entries, then the problem's.
   baseOptions.fingerprint = options.fingerprint;
-  const ::morea::RunFingerprint ofProblem = RunFingerprintOf(problem, parameters);
+  const morea_core::RunFingerprint ofProblem = RunFingerprintOf(problem, parameters);
   for (const auto & [key, value] : ofProblem.Entries())
     baseOptions.fingerprint.Add(key, value);
 
-  ::morea::CheckpointWriter checkpoints; // files written while the next generations run
+  morea_core::CheckpointWriter checkpoints; // files written while the next generations run
   std::size_t               checkpointGeneration = 0; // of the last checkpoint written; 0: none
   std::string               checkpointPath = options.checkpointPath;
   std::size_t               generation = 0;
   // Each level's solutions carried over to the next (refined) mesh.
-  std::vector<::morea::DualMesh> carriedPopulation, carriedArchive;
+  std::vector<morea_core::DualMesh> carriedPopulation, carriedArchive;
   std::optional<MeshModel>       refined;
   double                         secondsLevels = 0.0;
   try
@@ -192,10 +192,10 @@ RegisterMeshes(const RegistrationProblem & problem, const ::morea::ParameterSet 
         model = std::move(*refined);
         refined.reset();
       }
-      const ::morea::FoldConstraint constraint(model.topology, model.base.points,
+      const morea_core::FoldConstraint constraint(model.topology, model.base.points,
                                                parameters.GetReal("morea_fold_volume_fraction"));
-      const ::morea::TetrahedronEvaluator evaluator(model.topology, constraint, model.elasticity, model.rigidity, data);
-      auto backend = ::morea::CreateEvaluationBackend(request, evaluator, level == 0 ? &result.backendNote : nullptr);
+      const morea_core::TetrahedronEvaluator evaluator(model.topology, constraint, model.elasticity, model.rigidity, data);
+      auto backend = morea_core::CreateEvaluationBackend(request, evaluator, level == 0 ? &result.backendNote : nullptr);
       if (level == 0)
       {
         result.backend = backend->Name();
@@ -205,17 +205,17 @@ RegisterMeshes(const RegistrationProblem & problem, const ::morea::ParameterSet 
       }
       start = Clock::now();
 
-      ::morea::GomeaOptions gomea = baseOptions;
-      gomea.boundRefusals = ::morea::UsesRefusalBounds(options.refusalBounds, *backend);
+      morea_core::GomeaOptions gomea = baseOptions;
+      gomea.boundRefusals = morea_core::UsesRefusalBounds(options.refusalBounds, *backend);
       gomea.firstGeneration = plan.FirstGeneration(level);
       gomea.generations = plan.EndGeneration(level);
       gomea.fingerprint.AddEvaluationBackend(result.backend);
       if (plan.levels > 1)
         gomea.fingerprint.Add("mesh level", std::to_string(level) + " of " + std::to_string(plan.levels));
-      ::morea::RunShape shape = ::morea::RunShapeOf(gomea, model.topology, model.parallel);
+      morea_core::RunShape shape = morea_core::RunShapeOf(gomea, model.topology, model.parallel);
       shape.checkpoints = !options.checkpointPath.empty();
-      ::morea::CheckRunMemory(shape, *backend); // before the population exists, not as bad_alloc midway
-      ::morea::MoRvGomea optimiser(model.base, model.topology, model.parallel, constraint, *backend, gomea);
+      morea_core::CheckRunMemory(shape, *backend); // before the population exists, not as bad_alloc midway
+      morea_core::MoRvGomea optimiser(model.base, model.topology, model.parallel, constraint, *backend, gomea);
       checkpointPath = LevelCheckpointPath(options.checkpointPath, level, plan);
       if (options.resume && !checkpointPath.empty() && std::filesystem::exists(checkpointPath))
       {
@@ -226,9 +226,9 @@ RegisterMeshes(const RegistrationProblem & problem, const ::morea::ParameterSet 
       else
       {
         if (level == 0)
-          optimiser.Initialize(::morea::GenerateInitialPopulation(
+          optimiser.Initialize(morea_core::GenerateInitialPopulation(
             model.base, constraint, gomea.populationSize, gomea.seed,
-            ::morea::InitialPopulationOptions::FromParameters(parameters)));
+            morea_core::InitialPopulationOptions::FromParameters(parameters)));
         else
           optimiser.Initialize(std::move(carriedPopulation), carriedArchive);
         // Later levels' files are another run's now: a resume must not take them.
@@ -260,13 +260,13 @@ RegisterMeshes(const RegistrationProblem & problem, const ::morea::ParameterSet 
       result.history.insert(result.history.end(), history.begin() + (level > 0 ? 1 : 0), history.end());
       if (level + 1 < plan.levels)
       {
-        ::morea::MeshRefinement refinement;
+        morea_core::MeshRefinement refinement;
         refined = RefineMeshModel(model, problem, parameters, NextLevelDensity(model, optimiser.Archive(), *backend),
                                   plan.PointsAt(level + 1, coarsePoints), refinement);
         for (const auto & solution : optimiser.Population())
-          carriedPopulation.push_back(::morea::CarryOver(refinement, solution));
+          carriedPopulation.push_back(morea_core::CarryOver(refinement, solution));
         for (const auto & e : optimiser.Archive().Entries())
-          carriedArchive.push_back(::morea::CarryOver(refinement, e.solution));
+          carriedArchive.push_back(morea_core::CarryOver(refinement, e.solution));
       }
       else
       {
@@ -276,7 +276,7 @@ RegisterMeshes(const RegistrationProblem & problem, const ::morea::ParameterSet 
       secondsLevels += std::chrono::duration<double>(Clock::now() - start).count();
     }
   }
-  catch (const ::morea::OutOfDeviceMemory & e)
+  catch (const morea_core::OutOfDeviceMemory & e)
   {
     // Another process took the device's memory, or the estimate fell
     // short: say what ran out where, and what is left to resume from.
@@ -289,7 +289,7 @@ RegisterMeshes(const RegistrationProblem & problem, const ::morea::ParameterSet 
     if (checkpointGeneration > 0)
       message += "; the checkpoint " + checkpointPath + " (generation " + std::to_string(checkpointGeneration) +
                  ") resumes on a device with room";
-    throw ::morea::Error(message);
+    throw morea_core::Error(message);
   }
   checkpoints.Wait();
   result.model = std::move(model);

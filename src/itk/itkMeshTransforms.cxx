@@ -6,7 +6,7 @@
 #include "itkMOREAImageIO.h"
 #include "itkPhantomImages.h"
 #include "itkRegistrationEvaluation.h"
-#include "morea/Error.h"
+#include "morea_core/Error.h"
 #include "vnl/algo/vnl_determinant.h"
 
 #include <cmath>
@@ -23,7 +23,7 @@ namespace
 {
 /** A core volume with the geometry of `image` in `frame` and its voxels. */
 template <typename TValue, typename TImage>
-::morea::Volume<TValue>
+morea_core::Volume<TValue>
 ToFrameVolume(const TImage * image, const DomainFrame & frame, const char * what)
 {
   if (image == nullptr)
@@ -35,7 +35,7 @@ ToFrameVolume(const TImage * image, const DomainFrame & frame, const char * what
     itkGenericExceptionMacro(<< "cannot convert a partly buffered " << what);
   }
   const auto              geometry = frame.GeometryOf(image);
-  ::morea::Volume<TValue> volume(geometry.size, geometry.spacing, geometry.origin);
+  morea_core::Volume<TValue> volume(geometry.size, geometry.spacing, geometry.origin);
   const auto *            buffer = image->GetBufferPointer();
   // ITK's buffer order is the core's: x fastest, then y, then z.
   for (std::size_t i = 0; i < volume.data.size(); ++i)
@@ -47,7 +47,7 @@ ToFrameVolume(const TImage * image, const DomainFrame & frame, const char * what
 
 template <typename TImage>
 void
-PlaceInFrame(TImage * image, const ::morea::Vec3 & frameOrigin, const DomainFrame & frame)
+PlaceInFrame(TImage * image, const morea_core::Vec3 & frameOrigin, const DomainFrame & frame)
 {
   image->SetOrigin(frame.ToPhysical(frameOrigin));
   image->SetDirection(frame.GetDirection());
@@ -107,10 +107,10 @@ DomainFrame::IsAlignedWith(const ImageBase<Dimension> * grid, double tolerance) 
   return true;
 }
 
-::morea::Vec3
+morea_core::Vec3
 DomainFrame::ToFrame(const PointType & physical) const
 {
-  ::morea::Vec3 q{ { 0.0, 0.0, 0.0 } };
+  morea_core::Vec3 q{ { 0.0, 0.0, 0.0 } };
   for (unsigned r = 0; r < Dimension; ++r)
   {
     for (unsigned c = 0; c < Dimension; ++c)
@@ -122,7 +122,7 @@ DomainFrame::ToFrame(const PointType & physical) const
 }
 
 PointType
-DomainFrame::ToPhysical(const ::morea::Vec3 & frame) const
+DomainFrame::ToPhysical(const morea_core::Vec3 & frame) const
 {
   PointType p;
   for (unsigned r = 0; r < Dimension; ++r)
@@ -132,7 +132,7 @@ DomainFrame::ToPhysical(const ::morea::Vec3 & frame) const
   return p;
 }
 
-::morea::Vec3
+morea_core::Vec3
 DomainFrame::VectorToFrame(const DisplacementVectorType & physical) const
 {
   PointType p;
@@ -144,7 +144,7 @@ DomainFrame::VectorToFrame(const DisplacementVectorType & physical) const
 }
 
 DisplacementVectorType
-DomainFrame::VectorToPhysical(const ::morea::Vec3 & frame) const
+DomainFrame::VectorToPhysical(const morea_core::Vec3 & frame) const
 {
   DisplacementVectorType v;
   for (unsigned r = 0; r < Dimension; ++r)
@@ -180,15 +180,15 @@ DomainFrame::GeometryOf(const ImageBase<Dimension> * grid) const
   return geometry;
 }
 
-::morea::Volume<::morea::Vec3>
+morea_core::Volume<morea_core::Vec3>
 DomainFrame::FieldGridOf(const ImageBase<Dimension> * grid) const
 {
   const GridGeometry geometry = GeometryOf(grid);
-  return ::morea::Volume<::morea::Vec3>(geometry.size, geometry.spacing, geometry.origin);
+  return morea_core::Volume<morea_core::Vec3>(geometry.size, geometry.spacing, geometry.origin);
 }
 
 ImageType::Pointer
-ToImage(const ::morea::Volume<float> & volume, const DomainFrame & frame)
+ToImage(const morea_core::Volume<float> & volume, const DomainFrame & frame)
 {
   ImageType::Pointer image = ToImage(volume);
   PlaceInFrame(image.GetPointer(), volume.origin, frame);
@@ -196,27 +196,27 @@ ToImage(const ::morea::Volume<float> & volume, const DomainFrame & frame)
 }
 
 MaskType::Pointer
-ToMask(const ::morea::Volume<std::uint8_t> & volume, const DomainFrame & frame)
+ToMask(const morea_core::Volume<std::uint8_t> & volume, const DomainFrame & frame)
 {
   MaskType::Pointer mask = ToMask(volume);
   PlaceInFrame(mask.GetPointer(), volume.origin, frame);
   return mask;
 }
 
-::morea::Volume<float>
+morea_core::Volume<float>
 ToVolume(const ImageType * image, const DomainFrame & frame)
 {
   return ToFrameVolume<float>(image, frame, "image");
 }
 
-::morea::Volume<std::uint8_t>
+morea_core::Volume<std::uint8_t>
 ToVolume(const MaskType * mask, const DomainFrame & frame)
 {
   return ToFrameVolume<std::uint8_t>(mask, frame, "mask");
 }
 
 MeshFields
-RasterizeSolution(const ::morea::MeshTopology & topology, const ::morea::DualMesh & solution,
+RasterizeSolution(const morea_core::MeshTopology & topology, const morea_core::DualMesh & solution,
                   const ImageBase<Dimension> * fixedGrid, const ImageBase<Dimension> * movingGrid)
 {
   if (fixedGrid == nullptr || movingGrid == nullptr)
@@ -235,15 +235,15 @@ RasterizeSolution(const ::morea::MeshTopology & topology, const ::morea::DualMes
   // repair is serial and takes a good part of a second on a folded field).
   struct Rasterized
   {
-    ::morea::Volume<::morea::Vec3>  volume;
-    ::morea::RasterizationReport    report;
-    ::morea::FieldFoldRepairReport repair;
+    morea_core::Volume<morea_core::Vec3>  volume;
+    morea_core::RasterizationReport    report;
+    morea_core::FieldFoldRepairReport repair;
   };
-  auto rasterizeVolume = [&topology](const std::vector<::morea::Vec3> & from, const std::vector<::morea::Vec3> & to,
-                                     ::morea::Volume<::morea::Vec3> volume) {
+  auto rasterizeVolume = [&topology](const std::vector<morea_core::Vec3> & from, const std::vector<morea_core::Vec3> & to,
+                                     morea_core::Volume<morea_core::Vec3> volume) {
     Rasterized r{ std::move(volume), {}, {} };
-    ::morea::RasterizeDisplacement(topology, from, to, r.volume, &r.report);
-    r.repair = ::morea::RemoveVoxelFolds(r.volume);
+    morea_core::RasterizeDisplacement(topology, from, to, r.volume, &r.report);
+    r.repair = morea_core::RemoveVoxelFolds(r.volume);
     return r;
   };
   // ... and as a physical displacement field on the grid's full geometry.
@@ -256,13 +256,13 @@ RasterizeSolution(const ::morea::MeshTopology & topology, const ::morea::DualMes
     }
     return field;
   };
-  auto rasterize = [&](const std::vector<::morea::Vec3> & from, const std::vector<::morea::Vec3> & to,
+  auto rasterize = [&](const std::vector<morea_core::Vec3> & from, const std::vector<morea_core::Vec3> & to,
                        const ImageBase<Dimension> * grid) {
     try
     {
       return toField(rasterizeVolume(from, to, frame.FieldGridOf(grid)), grid);
     }
-    catch (const ::morea::Error & e)
+    catch (const morea_core::Error & e)
     {
       itkGenericExceptionMacro(<< e.what());
     }
@@ -278,7 +278,7 @@ RasterizeSolution(const ::morea::MeshTopology & topology, const ::morea::DualMes
       forward = rasterizeVolume(solution.target, solution.source, frame.FieldGridOf(fixedGrid));
       backward = later.get();
     }
-    catch (const ::morea::Error & e)
+    catch (const morea_core::Error & e)
     {
       itkGenericExceptionMacro(<< e.what());
     }
@@ -307,16 +307,16 @@ RasterizeSolution(const ::morea::MeshTopology & topology, const ::morea::DualMes
 }
 
 void
-WriteMeshVtu(const std::string & path, const ::morea::MeshTopology & topology,
-             const std::vector<::morea::Vec3> & framePoints, const DomainFrame & frame,
-             const std::vector<::morea::VtuArray> & cellData, const std::vector<::morea::VtuArray> & pointData)
+WriteMeshVtu(const std::string & path, const morea_core::MeshTopology & topology,
+             const std::vector<morea_core::Vec3> & framePoints, const DomainFrame & frame,
+             const std::vector<morea_core::VtuArray> & cellData, const std::vector<morea_core::VtuArray> & pointData)
 {
   if (framePoints.size() != topology.NumberOfPoints())
   {
     itkGenericExceptionMacro(<< "cannot write '" << path << "': the topology has " << topology.NumberOfPoints()
                              << " points but " << framePoints.size() << " were given");
   }
-  std::vector<::morea::Vec3> physical;
+  std::vector<morea_core::Vec3> physical;
   physical.reserve(framePoints.size());
   for (const auto & q : framePoints)
   {
@@ -324,7 +324,7 @@ WriteMeshVtu(const std::string & path, const ::morea::MeshTopology & topology,
     physical.push_back({ { p[0], p[1], p[2] } });
   }
   // A reflection flips every tetrahedron's orientation; one swap flips it back.
-  std::vector<::morea::Tetrahedron> tetrahedra = topology.Tetrahedra();
+  std::vector<morea_core::Tetrahedron> tetrahedra = topology.Tetrahedra();
   if (vnl_determinant(frame.GetDirection().GetVnlMatrix()) < 0.0)
   {
     for (auto & t : tetrahedra)
@@ -334,9 +334,9 @@ WriteMeshVtu(const std::string & path, const ::morea::MeshTopology & topology,
   }
   try
   {
-    ::morea::WriteVtu(path, physical, tetrahedra, cellData, pointData);
+    morea_core::WriteVtu(path, physical, tetrahedra, cellData, pointData);
   }
-  catch (const ::morea::Error & e)
+  catch (const morea_core::Error & e)
   {
     itkGenericExceptionMacro(<< e.what());
   }

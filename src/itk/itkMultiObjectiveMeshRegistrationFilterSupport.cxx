@@ -2,10 +2,10 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "itkMultiObjectiveMeshRegistrationFilterSupport.h"
 
-#include "morea/Error.h"
-#include "morea/MemoryEstimate.h"
-#include "morea/ParameterSet.h"
-#include "morea/ParetoFront.h"
+#include "morea_core/Error.h"
+#include "morea_core/MemoryEstimate.h"
+#include "morea_core/ParameterSet.h"
+#include "morea_core/ParetoFront.h"
 
 #include <algorithm>
 #include <chrono>
@@ -21,14 +21,14 @@ namespace
 {
 const char * const SelectionHelp = "best-guidance, knee, weighted:a:b:c, nearest:m:i:g, all";
 
-::morea::ObjectiveVector
+morea_core::ObjectiveVector
 ParseTriple(const std::string & item, const std::string & text)
 {
   std::vector<std::string> parts;
   std::istringstream       in(text);
   for (std::string part; std::getline(in, part, ':');)
     parts.push_back(part);
-  ::morea::ObjectiveVector v{};
+  morea_core::ObjectiveVector v{};
   try
   {
     if (parts.size() != 3)
@@ -43,7 +43,7 @@ ParseTriple(const std::string & item, const std::string & text)
   }
   catch (const std::exception &)
   {
-    throw ::morea::Error("selection: '" + item + "' needs three numbers (magnitude:intensity:guidance)");
+    throw morea_core::Error("selection: '" + item + "' needs three numbers (magnitude:intensity:guidance)");
   }
   return v;
 }
@@ -51,23 +51,23 @@ ParseTriple(const std::string & item, const std::string & text)
 /** Walks the selection; `add` gets each choice. With an empty `objectives`
  *  only the syntax is checked (no index is computed). */
 void
-ForEachChoice(const std::string & selection, const std::vector<::morea::ObjectiveVector> & objectives,
+ForEachChoice(const std::string & selection, const std::vector<morea_core::ObjectiveVector> & objectives,
               const std::function<void(const std::string &, std::size_t)> & add)
 {
   const bool check = objectives.empty();
   bool       any = false;
-  for (const std::string & item : ::morea::ParseNameList(selection))
+  for (const std::string & item : morea_core::ParseNameList(selection))
   {
     any = true;
     if (item == "best-guidance")
     {
       if (!check)
-        add("best_guidance", ::morea::SelectBestGuidance(objectives));
+        add("best_guidance", morea_core::SelectBestGuidance(objectives));
     }
     else if (item == "knee")
     {
       if (!check)
-        add("knee", ::morea::SelectKnee(objectives));
+        add("knee", morea_core::SelectKnee(objectives));
     }
     else if (item == "all")
     {
@@ -78,19 +78,19 @@ ForEachChoice(const std::string & selection, const std::vector<::morea::Objectiv
     {
       const auto weights = ParseTriple(item, item.substr(9));
       if (!check)
-        add("weighted", ::morea::SelectWeighted(objectives, weights));
+        add("weighted", morea_core::SelectWeighted(objectives, weights));
     }
     else if (item.rfind("nearest:", 0) == 0)
     {
       const auto point = ParseTriple(item, item.substr(8));
       if (!check)
-        add("nearest", ::morea::SelectNearest(objectives, point));
+        add("nearest", morea_core::SelectNearest(objectives, point));
     }
     else
-      throw ::morea::Error("selection: unknown choice '" + item + "' (" + SelectionHelp + ")");
+      throw morea_core::Error("selection: unknown choice '" + item + "' (" + SelectionHelp + ")");
   }
   if (!any)
-    throw ::morea::Error(std::string("selection: no solution named (") + SelectionHelp + ")");
+    throw morea_core::Error(std::string("selection: no solution named (") + SelectionHelp + ")");
 }
 } // namespace
 
@@ -134,8 +134,8 @@ SelectSolutions(const ApproximationSet & set, const std::string & selection)
 {
   CheckSolutionSelection(selection);
   if (set.empty())
-    throw ::morea::Error("the approximation set is empty: no fold-free solution was found");
-  std::vector<::morea::ObjectiveVector> objectives;
+    throw morea_core::Error("the approximation set is empty: no fold-free solution was found");
+  std::vector<morea_core::ObjectiveVector> objectives;
   for (const auto & s : set)
     objectives.push_back(s.objectives);
   std::vector<SolutionChoice> chosen;
@@ -149,19 +149,19 @@ SelectSolutions(const ApproximationSet & set, const std::string & selection)
 }
 
 void
-CheckSingleRunParameters(const ::morea::ParameterSet & parameters)
+CheckSingleRunParameters(const morea_core::ParameterSet & parameters)
 {
   if (const auto runs = parameters.GetInteger("num_runs"); runs > 1)
-    throw ::morea::Error("num_runs = " + std::to_string(runs) +
+    throw morea_core::Error("num_runs = " + std::to_string(runs) +
                          ": one registration runs at a time here; run it once per seed (morea register runs "
                          "num_runs registrations with consecutive seeds), or set num_runs = 1");
   if (parameters.GetBool("zip"))
-    throw ::morea::Error("zip = true: this registration writes no output folder to compress (morea register "
+    throw morea_core::Error("zip = true: this registration writes no output folder to compress (morea register "
                          "does); set zip = false");
 }
 
 MultiObjectiveRegistrationRun
-RunMultiObjectiveRegistration(const RegistrationProblem & problem, const ::morea::ParameterSet & parameters,
+RunMultiObjectiveRegistration(const RegistrationProblem & problem, const morea_core::ParameterSet & parameters,
                               const MeshRegistrationOptions & options, const std::string & selection,
                               const std::function<void(double)> & progress,
                               const PreAlignmentTransformType * initialTransform)
@@ -177,16 +177,16 @@ RunMultiObjectiveRegistration(const RegistrationProblem & problem, const ::morea
   // Cheap checks first, so that a typo does not surface after the whole run.
   CheckSolutionSelection(selection);
   CheckSingleRunParameters(parameters);
-  ::morea::CheckRunMemory(parameters); // an absurd population at once; RegisterMeshes checks the whole run
+  morea_core::CheckRunMemory(parameters); // an absurd population at once; RegisterMeshes checks the whole run
   MeshRegistrationOptions registration = options;
   registration.device = static_cast<int>(parameters.GetInteger("cuda_gpu_id"));
   registration.minimumComputeLevel = static_cast<int>(parameters.GetInteger("cuda_compute_level"));
   {
-    ::morea::BackendRequest request;
+    morea_core::BackendRequest request;
     request.choice = registration.backend;
     request.device = registration.device;
     request.minimumComputeLevel = registration.minimumComputeLevel;
-    ::morea::CheckBackendRequest(request); // a device asked for by name but unusable: before the work
+    morea_core::CheckBackendRequest(request); // a device asked for by name but unusable: before the work
   }
   problem.Validate();
 
@@ -199,7 +199,7 @@ RunMultiObjectiveRegistration(const RegistrationProblem & problem, const ::morea
   run.secondsPreprocessing = secondsSince(stage);
   report(PreprocessingProgressShare);
 
-  registration.onGeneration = [&](const ::morea::GenerationRecord & record, std::size_t generations) {
+  registration.onGeneration = [&](const morea_core::GenerationRecord & record, std::size_t generations) {
     const double done = generations > 0 ? static_cast<double>(record.generation) / static_cast<double>(generations) : 1.0;
     report(PreprocessingProgressShare + (OptimisationProgressEnd - PreprocessingProgressShare) * std::min(1.0, done));
     if (options.onGeneration)
@@ -252,7 +252,7 @@ UserMessage(const std::string & description)
 }
 
 void
-PrintParameters(std::ostream & os, const ::morea::ParameterSet & parameters, Indent indent)
+PrintParameters(std::ostream & os, const morea_core::ParameterSet & parameters, Indent indent)
 {
   // The main run keys always, the rest only when set: all ~50 keys would bury them.
   static const char * const always[] = { "ea_num_generations", "ea_population_size", "morea_mesh_num_points",

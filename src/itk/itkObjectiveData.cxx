@@ -7,7 +7,7 @@
 #include "itkMOREAImageIO.h"
 #include "itkPreprocessing.h"
 #include "itkSignedMaurerDistanceMapImageFilter.h"
-#include "morea/ParameterSet.h"
+#include "morea_core/ParameterSet.h"
 
 #include <cmath>
 #include <cstddef>
@@ -168,7 +168,7 @@ ContourPointCount(const Structure & structure, bool fixedSide)
 
 /** Copies `volume` into channel `c` of `target`, whose grid it must share. */
 void
-SetChannel(::morea::ChannelVolume & target, std::size_t c, const ::morea::Volume<float> & volume)
+SetChannel(morea_core::ChannelVolume & target, std::size_t c, const morea_core::Volume<float> & volume)
 {
   for (std::size_t v = 0; v < volume.data.size(); ++v)
   {
@@ -176,10 +176,10 @@ SetChannel(::morea::ChannelVolume & target, std::size_t c, const ::morea::Volume
   }
 }
 
-::morea::ChannelVolume
-MakeChannelVolume(const ::morea::Volume<float> & intensity, std::size_t channels)
+morea_core::ChannelVolume
+MakeChannelVolume(const morea_core::Volume<float> & intensity, std::size_t channels)
 {
-  ::morea::ChannelVolume volume;
+  morea_core::ChannelVolume volume;
   volume.size = intensity.size;
   volume.spacing = intensity.spacing;
   volume.origin = intensity.origin;
@@ -229,16 +229,16 @@ StructureDistanceMap(const Structure & structure, bool fixedSide, const ImageBas
   return DistanceFromPoints(points, grid, what);
 }
 
-::morea::ObjectiveData
+morea_core::ObjectiveData
 BuildObjectiveData(const RegistrationProblem & problem, const MeshModel & model,
-                   const ::morea::ParameterSet & parameters)
+                   const morea_core::ParameterSet & parameters)
 {
   return BuildObjectiveData(problem, model.frame, parameters);
 }
 
-::morea::ObjectiveData
+morea_core::ObjectiveData
 BuildObjectiveData(const RegistrationProblem & problem, const DomainFrame & frame,
-                   const ::morea::ParameterSet & parameters)
+                   const morea_core::ParameterSet & parameters)
 {
   if (!problem.fixedImage || !problem.movingImage)
   {
@@ -253,7 +253,7 @@ BuildObjectiveData(const RegistrationProblem & problem, const DomainFrame & fram
     Fail("the mesh model's domain frame is not the images' frame");
   }
 
-  ::morea::ObjectiveData data;
+  morea_core::ObjectiveData data;
   if (parameters.GetBool("problem_guidance_enabled"))
   {
     data.guidanceNames = GuidanceStructureNames(problem, parameters);
@@ -307,14 +307,14 @@ BuildObjectiveData(const RegistrationProblem & problem, const DomainFrame & fram
   }
 
   // The mesh domain spans the voxel centres (MeshDomain::OfGrid), as the channel volumes' grid.
-  ::morea::Vec3 extent;
+  morea_core::Vec3 extent;
   data.voxelVolume = 1.0;
   for (unsigned d = 0; d < Dimension; ++d)
   {
     extent[d] = data.moving.spacing[d] * static_cast<double>(data.moving.size[d] - 1);
     data.voxelVolume *= problem.fixedImage->GetSpacing()[d];
   }
-  data.guidanceRadius = ::morea::DefaultGuidanceRadius(extent);
+  data.guidanceRadius = morea_core::DefaultGuidanceRadius(extent);
   data.samplingRate = parameters.GetReal("morea_sampling_rate");
   return data;
 }

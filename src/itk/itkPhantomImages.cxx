@@ -18,7 +18,7 @@ namespace
 {
 template <typename TImage, typename TValue, typename TConvert>
 typename TImage::Pointer
-Convert(const ::morea::Volume<TValue> & volume, TConvert convert)
+Convert(const morea_core::Volume<TValue> & volume, TConvert convert)
 {
   auto                          image = TImage::New();
   typename TImage::SizeType     size;
@@ -42,7 +42,7 @@ Convert(const ::morea::Volume<TValue> & volume, TConvert convert)
 }
 
 LandmarkListType
-ToPoints(const std::vector<::morea::Vec3> & points)
+ToPoints(const std::vector<morea_core::Vec3> & points)
 {
   LandmarkListType out;
   for (const auto & p : points)
@@ -57,21 +57,21 @@ ToPoints(const std::vector<::morea::Vec3> & points)
 } // namespace
 
 ImageType::Pointer
-ToImage(const ::morea::Volume<float> & volume)
+ToImage(const morea_core::Volume<float> & volume)
 {
   return Convert<ImageType>(volume, [](float v) { return v; });
 }
 
 MaskType::Pointer
-ToMask(const ::morea::Volume<std::uint8_t> & volume)
+ToMask(const morea_core::Volume<std::uint8_t> & volume)
 {
   return Convert<MaskType>(volume, [](std::uint8_t v) -> unsigned char { return v != 0 ? 1 : 0; });
 }
 
 DisplacementFieldType::Pointer
-ToDisplacementField(const ::morea::Volume<::morea::Vec3> & volume)
+ToDisplacementField(const morea_core::Volume<morea_core::Vec3> & volume)
 {
-  return Convert<DisplacementFieldType>(volume, [](const ::morea::Vec3 & v) {
+  return Convert<DisplacementFieldType>(volume, [](const morea_core::Vec3 & v) {
     DisplacementVectorType u;
     for (unsigned d = 0; d < Dimension; ++d)
       u[d] = v[d];
@@ -80,12 +80,12 @@ ToDisplacementField(const ::morea::Volume<::morea::Vec3> & volume)
 }
 
 RegistrationProblem
-MakePhantomProblem(const ::morea::PelvisPhantom::Case & c)
+MakePhantomProblem(const morea_core::PelvisPhantom::Case & c)
 {
   RegistrationProblem problem;
   problem.fixedImage = ToImage(c.fixedImage);
   problem.movingImage = ToImage(c.movingImage);
-  const auto & names = ::morea::PelvisPhantom::StructureNames();
+  const auto & names = morea_core::PelvisPhantom::StructureNames();
   for (std::size_t s = 0; s < names.size(); ++s)
   {
     Structure structure;
@@ -100,7 +100,7 @@ MakePhantomProblem(const ::morea::PelvisPhantom::Case & c)
 }
 
 PhantomFiles
-WritePhantomCase(const ::morea::PelvisPhantom::Case & c, const std::string & folder)
+WritePhantomCase(const morea_core::PelvisPhantom::Case & c, const std::string & folder)
 {
   const fs::path root(folder);
   PhantomFiles   files;
@@ -108,7 +108,7 @@ WritePhantomCase(const ::morea::PelvisPhantom::Case & c, const std::string & fol
   files.movingImage = (root / "moving.nii.gz").string();
   WriteImage(ToImage(c.fixedImage), files.fixedImage);
   WriteImage(ToImage(c.movingImage), files.movingImage);
-  const auto & names = ::morea::PelvisPhantom::StructureNames();
+  const auto & names = morea_core::PelvisPhantom::StructureNames();
   for (std::size_t s = 0; s < names.size(); ++s)
   {
     files.fixedMasks[names[s]] = (root / "fixed_masks" / (names[s] + ".nii.gz")).string();

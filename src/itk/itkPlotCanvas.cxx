@@ -4,7 +4,7 @@
 
 #include "itkMOREAImageIO.h"
 #include "itkPlotFont.h"
-#include "morea/Error.h"
+#include "morea_core/Error.h"
 
 #include <zlib.h>
 
@@ -240,7 +240,7 @@ PlotCanvas::EncodePng() const
   std::string deflated(size, '\0');
   if (compress2(reinterpret_cast<Bytef *>(&deflated[0]), &size, reinterpret_cast<const Bytef *>(raw.data()),
                 static_cast<uLong>(raw.size()), 6) != Z_OK)
-    throw ::morea::Error("cannot compress a PNG image");
+    throw morea_core::Error("cannot compress a PNG image");
   deflated.resize(size);
   AppendChunk(png, "IDAT", deflated);
   AppendChunk(png, "IEND", "");

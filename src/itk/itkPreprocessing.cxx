@@ -12,7 +12,7 @@
 #include "itkRegionOfInterestImageFilter.h"
 #include "itkResampleImageFilter.h"
 #include "itkSignedMaurerDistanceMapImageFilter.h"
-#include "morea/ParameterSet.h"
+#include "morea_core/ParameterSet.h"
 
 #include <algorithm>
 #include <array>
@@ -147,7 +147,7 @@ SecondsSince(std::chrono::steady_clock::time_point start)
 } // namespace
 
 PreprocessOptions
-PreprocessOptions::FromParameters(const ::morea::ParameterSet & p)
+PreprocessOptions::FromParameters(const morea_core::ParameterSet & p)
 {
   PreprocessOptions o;
   o.isotropicSpacing = p.GetReal("preprocess_isotropic_spacing");
@@ -639,11 +639,11 @@ Preprocess(const RegistrationProblem & given, const PreprocessOptions & options)
 }
 
 void
-CheckGuidanceStructuresKept(const PreprocessReport & report, const ::morea::ParameterSet & parameters)
+CheckGuidanceStructuresKept(const PreprocessReport & report, const morea_core::ParameterSet & parameters)
 {
   const std::string &            selection = parameters.GetString("problem_guidance_selection");
   const bool                     all = selection == "-1";
-  const std::vector<std::string> named = all ? std::vector<std::string>{} : ::morea::ParseNameList(selection);
+  const std::vector<std::string> named = all ? std::vector<std::string>{} : morea_core::ParseNameList(selection);
   for (std::size_t i = 0; i < report.droppedStructures.size(); ++i)
   {
     const std::string & name = report.droppedStructures[i];

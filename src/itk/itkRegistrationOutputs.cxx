@@ -10,7 +10,7 @@
 #include "itkRegistrationMetrics.h"
 #include "itkRegistrationPlots.h"
 #include "itkRegistrationRunFolder.h"
-#include "morea/Error.h"
+#include "morea_core/Error.h"
 #include "itkMOREAFail.h"
 
 #include <algorithm>
@@ -196,7 +196,7 @@ namespace
 {
 /** Every output but summary.json, written into `folder`; returns the summary. */
 nlohmann::json
-WriteOutputFiles(const MultiObjectiveRegistrationRun & run, const ::morea::ParameterSet & parameters,
+WriteOutputFiles(const MultiObjectiveRegistrationRun & run, const morea_core::ParameterSet & parameters,
                  const std::string & folder, const DisplacementFieldType * trueFixedToMoving,
                  const RegistrationOutputTimes * times)
 {
@@ -313,7 +313,7 @@ WriteOutputFiles(const MultiObjectiveRegistrationRun & run, const ::morea::Param
                              { "magnitude", s.fitness.objectives[0] },
                              { "intensity", s.fitness.objectives[1] },
                              { "guidance", s.fitness.objectives[2] } };
-    auto repairJson = [](const ::morea::FieldFoldRepairReport & r) {
+    auto repairJson = [](const morea_core::FieldFoldRepairReport & r) {
       return nlohmann::json{ { "folded_voxels_before", r.foldedBefore },
                              { "folded_voxels_after", r.foldedAfter },
                              { "voxels_smoothed", r.voxelsChanged },
@@ -395,7 +395,7 @@ IsTemporary(const std::string & name)
 } // namespace
 
 nlohmann::json
-WriteRegistrationOutputs(const MultiObjectiveRegistrationRun & run, const ::morea::ParameterSet & parameters,
+WriteRegistrationOutputs(const MultiObjectiveRegistrationRun & run, const morea_core::ParameterSet & parameters,
                          const std::string & folder, const DisplacementFieldType * trueFixedToMoving,
                          const RegistrationOutputTimes * times)
 {

@@ -6,7 +6,7 @@
 #include "itkImageRegionConstIterator.h"
 #include "itkImageRegionConstIteratorWithIndex.h"
 #include "itkRegistrationMetrics.h"
-#include "morea/Error.h"
+#include "morea_core/Error.h"
 
 #include <algorithm>
 #include <cmath>
@@ -18,7 +18,7 @@ namespace morea
 {
 namespace
 {
-using ::morea::Error;
+using morea_core::Error;
 
 /** The screen axes of a slice: index axis of the columns and of the rows, and
  *  whether rows run against their index axis (superior at the top). */

@@ -8,8 +8,8 @@
 #include "itkRegistrationOutputs.h"
 #include "itkRegistrationPlots.h"
 #include "itkTransformFileReader.h"
-#include "morea/Error.h"
-#include "morea/OutputFolderLock.h"
+#include "morea_core/Error.h"
+#include "morea_core/OutputFolderLock.h"
 
 #include <zlib.h>
 
@@ -26,7 +26,7 @@ namespace morea
 namespace
 {
 namespace fs = std::filesystem;
-using ::morea::Error;
+using morea_core::Error;
 
 constexpr char FrontMeshesMagic[8] = { 'M', 'O', 'R', 'E', 'A', 'F', 'M', '1' };
 
@@ -96,7 +96,7 @@ Exists(const fs::path & p)
 } // namespace
 
 void
-WriteFrontMeshes(const ::morea::MeshTopology & topology, const std::vector<FrontSolution> & front, const std::string & path)
+WriteFrontMeshes(const morea_core::MeshTopology & topology, const std::vector<FrontSolution> & front, const std::string & path)
 {
   const std::uint64_t points = topology.NumberOfPoints(), tetrahedra = topology.NumberOfTetrahedra();
   std::string         out(FrontMeshesMagic, sizeof FrontMeshesMagic);
@@ -146,7 +146,7 @@ CheckRunFolder(const std::string & folder)
   const bool hasSummary = Exists(root / RegistrationSummaryFileName);
   const bool hasFront = Exists(root / "front.json");
   const bool hasStaging = Exists(root / ".outputs.partial");
-  const bool hasLock = Exists(root / ::morea::OutputFolderLock::FileName);
+  const bool hasLock = Exists(root / morea_core::OutputFolderLock::FileName);
   if (!hasSummary && !hasFront && !hasStaging && !hasLock)
     throw Error("'" + folder + "' is not a MOREA run folder: it has neither summary.json nor front.json");
   if (hasLock)
@@ -154,7 +154,7 @@ CheckRunFolder(const std::string & folder)
     // Taken and released at once: a run (or an export) holding it is still writing.
     try
     {
-      const ::morea::OutputFolderLock probe(folder);
+      const morea_core::OutputFolderLock probe(folder);
     }
     catch (const Error & e)
     {
@@ -185,7 +185,7 @@ ReadRunFolder(const std::string & folder)
   try
   {
     run.summary = nlohmann::json::parse(ReadWholeFile((root / RegistrationSummaryFileName).string()));
-    run.parameters = ::morea::ParameterSet::FromFile((root / "parameters.toml").string());
+    run.parameters = morea_core::ParameterSet::FromFile((root / "parameters.toml").string());
 
     // The saved front.
     const std::string path = (root / FrontMeshesFileName).string();
@@ -203,7 +203,7 @@ ReadRunFolder(const std::string & folder)
     const auto tetrahedra = in.Get<std::uint64_t>();
     const auto solutions = in.Get<std::uint64_t>();
     in.Need(tetrahedra * 16);
-    std::vector<::morea::Tetrahedron> tets(tetrahedra);
+    std::vector<morea_core::Tetrahedron> tets(tetrahedra);
     for (auto & t : tets)
       for (auto & v : t)
       {
@@ -211,7 +211,7 @@ ReadRunFolder(const std::string & folder)
         if (v >= points)
           throw Error("'" + path + "' is damaged (a tetrahedron names point " + std::to_string(v) + ")");
       }
-    run.topology = ::morea::MeshTopology(tets, points);
+    run.topology = morea_core::MeshTopology(tets, points);
     in.Need(solutions * (8 + 32 + 1));
     for (std::uint64_t s = 0; s < solutions; ++s)
     {
@@ -301,7 +301,7 @@ ExportSavedSolution(const SavedRegistrationRun & run, std::size_t index, const M
     throw Error("solution " + std::to_string(index) + " of a front of " + std::to_string(run.front.size()));
   const auto &                    s = run.front[index];
   const std::string               label = "solution_" + std::to_string(s.id);
-  const ::morea::OutputFolderLock ownership(run.folder);
+  const morea_core::OutputFolderLock ownership(run.folder);
   const fs::path                  root(run.folder);
   if (!Exists(root / RegistrationSummaryFileName))
     throw Error("'" + run.folder + "' no longer holds a complete run");

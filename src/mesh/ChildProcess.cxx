@@ -1,6 +1,6 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/ChildProcess.h"
+#include "morea_core/ChildProcess.h"
 
 #include <algorithm>
 #include <chrono>
@@ -24,7 +24,7 @@
 #  define MOREA_HAVE_FORK 0
 #endif
 
-namespace morea
+namespace morea_core
 {
 namespace
 {
@@ -252,4 +252,4 @@ RunInChildProcess(const std::function<std::string()> & work, double timeoutSecon
   return result;
 #endif
 }
-} // namespace morea
+} // namespace morea_core

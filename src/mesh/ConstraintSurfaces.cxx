@@ -2,14 +2,14 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "ConstraintSurfaces.h"
 
-#include "morea/Error.h"
-#include "morea/SurfaceCheck.h"
+#include "morea_core/Error.h"
+#include "morea_core/SurfaceCheck.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 
-namespace morea
+namespace morea_core
 {
 namespace
 {
@@ -180,4 +180,4 @@ ConstrainedTetrahedralization::Run(const std::vector<Vec3> & points, bool mayDro
     return Tetrahedralize(points, {}, m_Options);
   return std::move(*result);
 }
-} // namespace morea
+} // namespace morea_core

@@ -7,15 +7,15 @@
 #ifndef morea_ConstraintSurfaces_h
 #define morea_ConstraintSurfaces_h
 
-#include "morea/StructureSurface.h"
-#include "morea/TetrahedralMesh.h"
-#include "morea/Tetrahedralization.h"
+#include "morea_core/StructureSurface.h"
+#include "morea_core/TetrahedralMesh.h"
+#include "morea_core/Tetrahedralization.h"
 
 #include <optional>
 #include <string>
 #include <vector>
 
-namespace morea
+namespace morea_core
 {
 /** The closed surface of `mask` (about `targetVertices` vertices) with every
  *  vertex at least `margin` inside `domain`, without self-intersections and
@@ -53,7 +53,7 @@ public:
   /** Tetrahedralises `points` with the surfaces still in use. When TetGen
    *  fails with them and `mayDropSurfaces`, the surfaces are tried again one
    *  by one and those TetGen fails on are dropped for good (a note each),
-   *  down to none; otherwise the failure is thrown (morea::Error). */
+   *  down to none; otherwise the failure is thrown (morea_core::Error). */
   TetrahedralizationResult
   Run(const std::vector<Vec3> & points, bool mayDropSurfaces, std::vector<std::string> & notes);
 
@@ -79,6 +79,6 @@ private:
   TetrahedralizationOptions m_Options;
   std::vector<Surface>      m_Surfaces;
 };
-} // namespace morea
+} // namespace morea_core
 
 #endif

@@ -1,14 +1,14 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/MeshGenerator.h"
+#include "morea_core/MeshGenerator.h"
 
 #include "ConstraintSurfaces.h"
-#include "morea/ChildProcess.h"
-#include "morea/Error.h"
-#include "morea/MeshPointPlacement.h"
-#include "morea/ParameterSet.h"
-#include "morea/StructureSurface.h"
-#include "morea/Tetrahedralization.h"
+#include "morea_core/ChildProcess.h"
+#include "morea_core/Error.h"
+#include "morea_core/MeshPointPlacement.h"
+#include "morea_core/ParameterSet.h"
+#include "morea_core/StructureSurface.h"
+#include "morea_core/Tetrahedralization.h"
 
 #include <algorithm>
 #include <chrono>
@@ -19,7 +19,7 @@
 #include <optional>
 #include <stdexcept>
 
-namespace morea
+namespace morea_core
 {
 namespace
 {
@@ -274,7 +274,7 @@ struct PhaseInputs
   std::function<Vec3(RandomGenerator &)> drawInside;
 };
 
-/** A TetGen failure in a strict phase: not a morea::Error, so that sliver
+/** A TetGen failure in a strict phase: not a morea_core::Error, so that sliver
  *  removal does not take it for a trial that failed. */
 struct StrictPhaseFailure : std::runtime_error
 {
@@ -658,4 +658,4 @@ GenerateMesh(const MeshDomain & domain, const std::vector<MeshStructure> & struc
     *reportOut = report;
   return mesh;
 }
-} // namespace morea
+} // namespace morea_core

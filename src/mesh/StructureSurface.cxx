@@ -1,6 +1,6 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/StructureSurface.h"
+#include "morea_core/StructureSurface.h"
 
 #include <vtkCellArray.h>
 #include <vtkCleanPolyData.h>
@@ -17,7 +17,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace morea
+namespace morea_core
 {
 namespace
 {
@@ -142,4 +142,4 @@ ExtractStructureSurface(const Volume<std::uint8_t> & mask, std::size_t targetVer
   }
   return surface;
 }
-} // namespace morea
+} // namespace morea_core

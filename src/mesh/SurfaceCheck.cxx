@@ -1,13 +1,13 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/SurfaceCheck.h"
+#include "morea_core/SurfaceCheck.h"
 
 #include <algorithm>
 #include <cmath>
 #include <map>
 #include <numeric>
 
-namespace morea
+namespace morea_core
 {
 namespace
 {
@@ -316,4 +316,4 @@ CountCrossings(const TriangleSurface & a, const TriangleSurface & b)
   return CountMeetingPairs(both.vertices, both.triangles,
                            [first](std::size_t i, std::size_t j) { return (i < first) != (j < first); });
 }
-} // namespace morea
+} // namespace morea_core

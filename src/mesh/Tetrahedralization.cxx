@@ -1,9 +1,9 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/Tetrahedralization.h"
+#include "morea_core/Tetrahedralization.h"
 
-#include "morea/ChildProcess.h"
-#include "morea/Error.h"
+#include "morea_core/ChildProcess.h"
+#include "morea_core/Error.h"
 
 #include <tetgen.h>
 
@@ -11,7 +11,7 @@
 #include <cstring>
 #include <string>
 
-namespace morea
+namespace morea_core
 {
 namespace
 {
@@ -216,4 +216,4 @@ Tetrahedralize(const std::vector<Vec3> & points, const std::vector<std::array<st
   }
   throw Error("TetGen could not tetrahedralise the mesh points: " + failure);
 }
-} // namespace morea
+} // namespace morea_core

@@ -1,8 +1,8 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-#include "morea/VtuWriter.h"
+#include "morea_core/VtuWriter.h"
 
-#include "morea/Error.h"
+#include "morea_core/Error.h"
 
 #include <vtkCellArray.h>
 #include <vtkCellData.h>
@@ -24,7 +24,7 @@
 
 namespace fs = std::filesystem;
 
-namespace morea
+namespace morea_core
 {
 namespace
 {
@@ -167,4 +167,4 @@ WriteVtu(const std::string & path, const std::vector<Vec3> & points, const std::
     throw Error("cannot write '" + path + "': cannot move the temporary file into place: " + ec.message());
   }
 }
-} // namespace morea
+} // namespace morea_core

@@ -21,9 +21,9 @@
 
 namespace
 {
-using morea::cuda::Check;
-using morea::cuda::Texture3D;
-using morea::cuda::TextureLayout;
+using morea_core::cuda::Check;
+using morea_core::cuda::Texture3D;
+using morea_core::cuda::TextureLayout;
 
 constexpr int Edge = 256;
 constexpr int Fetches = 64;
@@ -196,9 +196,9 @@ main()
       }
   const int       brickSize[3] = { brickEdge, brickEdge, brickEdge };
   const Texture3D tb(bricks.data(), 16, cudaCreateChannelDesc<uint4>(), brickSize, TextureLayout::Volume,
-                     morea::cuda::TextureFilter::Point);
+                     morea_core::cuda::TextureFilter::Point);
   const int                 threads = 132 * 2048 * 4;
-  morea::cuda::DeviceArray<float> buffer(threads);
+  morea_core::cuda::DeviceArray<float> buffer(threads);
   float *                         out = buffer.Data();
   cudaDeviceProp p{};
   cudaGetDeviceProperties(&p, 0);

@@ -14,8 +14,8 @@
 #include "itkRegistrationOutputs.h"
 #include "itkRegistrationPlots.h"
 #include "itkRegistrationRunFolder.h"
-#include "morea/Error.h"
-#include "morea/OutputFolderLock.h"
+#include "morea_core/Error.h"
+#include "morea_core/OutputFolderLock.h"
 
 #include <pybind11/functional.h>
 #include <pybind11/numpy.h>
@@ -230,7 +230,7 @@ UserCall(F && f)
   {
     throw py::value_error(itk::morea::UserMessage(e.GetDescription()));
   }
-  catch (const ::morea::Error & e)
+  catch (const morea_core::Error & e)
   {
     throw py::value_error(e.what());
   }
@@ -478,7 +478,7 @@ public:
     const auto parameters = m_Filter->GetParameters();
     py::gil_scoped_release release;
     return UserCall([&] {
-      const ::morea::OutputFolderLock ownership(folder);
+      const morea_core::OutputFolderLock ownership(folder);
       return itk::morea::WriteRegistrationOutputs(run, parameters, folder).dump();
     });
   }
@@ -675,7 +675,7 @@ public:
       png = UserCall([&] {
         const auto views = ViewsOf(index);
         if (width < 64 || width > 2048)
-          throw ::morea::Error("the slice width must be 64 to 2048 pixels");
+          throw morea_core::Error("the slice width must be 64 to 2048 pixels");
         return views
           ->Render(itk::morea::SliceAxisFromName(axis), slice, itk::morea::SliceViewFromName(view), contours,
                    views->PixelsPerMmForWidth(width))
@@ -742,7 +742,7 @@ private:
   Entry(long index)
   {
     if (index < 0 || static_cast<std::size_t>(index) >= m_Run.front.size())
-      throw ::morea::Error("solution " + std::to_string(index) + " is not in the front of " +
+      throw morea_core::Error("solution " + std::to_string(index) + " is not in the front of " +
                            std::to_string(m_Run.front.size()));
     std::lock_guard<std::mutex> lock(m_Mutex); // one rasterisation at a time
     for (auto it = m_Cache.begin(); it != m_Cache.end(); ++it)
@@ -782,10 +782,10 @@ PYBIND11_MODULE(_morea, m)
   m.def(
     "phantom",
     [](double spacing, std::uint64_t seed) {
-      ::morea::PhantomOptions options;
+      morea_core::PhantomOptions options;
       options.spacing = spacing;
       options.seed = seed;
-      const auto phantomCase = UserCall([&] { return ::morea::PelvisPhantom(options).Generate(); });
+      const auto phantomCase = UserCall([&] { return morea_core::PelvisPhantom(options).Generate(); });
       const auto problem = itk::morea::MakePhantomProblem(phantomCase);
       py::dict   out = ProblemToPython(problem);
       out["true_fixed_to_moving"] = FieldToPython(itk::morea::ToDisplacementField(phantomCase.fixedToMoving));
