@@ -93,6 +93,19 @@ def ants_version() -> str:
         return "antspyx unknown"
 
 
+def iterations_used(log: Path) -> list[int]:
+    """Iterations antsRegistration ran per level (its DIAGNOSTIC lines): a level
+    ends at its cap or earlier, when the convergence value over the last 10
+    iterations falls below 1e-6."""
+    used = []
+    for line in Path(log).read_text(errors="replace").splitlines():
+        if line.startswith("XXDIAGNOSTIC"):
+            used.append(0)
+        elif used and line.lstrip().startswith("1DIAGNOSTIC"):
+            used[-1] += 1
+    return used
+
+
 def compose_field(get_lib_fn, reference: Path, transforms: list[str], output: Path,
                   log: Path) -> None:
     """antsApplyTransforms -r reference -t ... -o [output,1]: the composition as
@@ -164,7 +177,8 @@ def run(problem: Path, out_dir: Path, total_regularization: float, seed: int,
             p.unlink()
     record = {
         "method": "ants", "version": ants_version(), "total_regularization": total_regularization,
-        "seed": seed, "iterations": list(iterations), "cc_radius": cc_radius,
+        "seed": seed, "iterations": list(iterations), "iterations_used": iterations_used(log),
+        "cc_radius": cc_radius,
         "gradient_step": gradient_step, "update_regularization": update_regularization,
         "composite_masks": composite_masks, "sigma_deltas": sigma_deltas(seed),
         "seconds": {"registration": seconds_registration,

@@ -71,6 +71,15 @@ def read_json(path: Path):
     return json.loads(Path(path).read_text())
 
 
+def md5(path: Path) -> str:
+    import hashlib
+    h = hashlib.md5()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
 def fill_placeholders(text: str, values: dict) -> str:
     """Replaces $name tokens (longest names first); fails on any left over."""
     for name in sorted(values, key=len, reverse=True):

@@ -31,6 +31,27 @@ class Pair:
     criteria: list[Criterion]             # the first decides the best configuration
     raw_args: list[str] = field(default_factory=list)   # filled by resolve()
     needs_data: bool = True
+    # A case of `morea phantom` (the phantom suite), written under out/raw.
+    phantom_case: str | None = None
+    # MOREA configurations: name -> extra `morea register` arguments. "default"
+    # is the one the tests compare; the others are reported beside it.
+    morea_variants: dict[str, list[str]] = field(default_factory=lambda: {"default": []})
+    # Score the landmarks per kind (phantom.json's landmark_kinds).
+    landmarks_by_kind: bool = False
+
+
+# The phantom suite at the paper's MOREA configuration (the GPU runs MOREA):
+# pair name -> (`morea phantom --case`, its most-deforming structure, what happens).
+PHANTOM_SUITE = {
+    "phantom-pelvis": ("pelvis", "bladder", "the bladder fills, the table moves"),
+    "phantom-emptying": ("bladder-emptying", "bladder",
+                         "the full bladder empties (ratio 11), the bowel descends"),
+    "phantom-gas": ("gas-pocket", "rectum", "a gas pocket in the moving rectum only"),
+    "phantom-static": ("static-bones", "bladder", "the bladder fills, the bones do not move"),
+}
+# Guidance without bones: every structure but bones and the body outline.
+NO_BONE_GUIDANCE = "bladder,rectum,bowel"
+NAMES = ["lung", "abdomen", "phantom", *PHANTOM_SUITE]
 
 
 def data_dir(explicit: str | None = None) -> Path:
@@ -57,7 +78,20 @@ def make(name: str, quick: bool) -> Pair:
                     [Criterion("dice:bladder", True, "bladder Dice"),
                      Criterion("hd95:bladder", False, "bladder HD95 (mm)")],
                     needs_data=False)
-    raise SystemExit(f"unknown pair {name!r} (lung, abdomen, phantom)")
+    if name in PHANTOM_SUITE:
+        case, organ, what = PHANTOM_SUITE[name]
+        criteria = [Criterion("tre_mean_mm", False, "TRE mean (mm), all landmarks"),
+                    Criterion(f"dice:{organ}", True, f"{organ} Dice"),
+                    Criterion("tre_mean_mm:bone", False, "bone TRE mean (mm)"),
+                    Criterion(f"hd95:{organ}", False, f"{organ} HD95 (mm)")]
+        if organ != "bladder":
+            criteria.insert(2, Criterion("dice:bladder", True, "bladder Dice"))
+        return Pair(name, f"phantom suite, `morea phantom --case {case}` ({what})",
+                    P / f"morea_{name.replace('-', '_')}.toml", organ, criteria,
+                    needs_data=False, phantom_case=case, landmarks_by_kind=True,
+                    morea_variants={"default": [], "no-bone-guidance": [
+                        "--set", f"problem_guidance_selection={NO_BONE_GUIDANCE}"]})
+    raise SystemExit(f"unknown pair {name!r} ({', '.join(NAMES)})")
 
 
 def resolve(pair: Pair, data: Path, out: Path, morea: str) -> None:
@@ -82,8 +116,16 @@ def resolve(pair: Pair, data: Path, out: Path, morea: str) -> None:
     else:
         raw = out / "raw"
         if not (raw / "phantom.json").exists():
-            common.run_command([morea, "phantom", "-o", raw], out / "logs" / "phantom.log")
+            common.run_command([morea, "phantom", *phantom_arguments(pair), "-o", raw],
+                               out / "logs" / "phantom.log")
         pair.raw_args = ["--problem", str(raw)]
+
+
+def phantom_arguments(pair: Pair) -> list[str]:
+    """`morea phantom` options of a phantom pair (spacing, noise and seed: the
+    tool's defaults, 2 mm, 15 HU, seed 1, so that the GPU machine writes the same
+    images again; the study's voxel size is its parameter file's)."""
+    return ["--case", pair.phantom_case] if pair.phantom_case else []
 
 
 def _require(d: Path) -> None:

@@ -14,6 +14,20 @@ from . import evaluation
 
 METHOD_LABEL = {"morea": "MOREA", "elastix": "elastix", "ants": "ANTs SyN",
                 "rigid baseline": "rigid baseline"}
+KIND_ORDER = ("bone", "wall", "organ", "soft")
+
+
+def method_label(key: str) -> str:
+    """A chosen-configuration key: a method, or "morea:<configuration>"."""
+    if key.startswith("morea:"):
+        return f"MOREA ({key.split(':', 1)[1].replace('-', ' ')})"
+    return METHOD_LABEL.get(key, key)
+
+
+def method_keys(chosen: dict) -> list[str]:
+    """The chosen configurations in table order: MOREA's first, then elastix, ANTs."""
+    return sorted(chosen, key=lambda k: (0 if k == "morea" else 1 if k.startswith("morea:")
+                                         else 2 if k == "elastix" else 3, k))
 
 
 def _fmt(v, digits=3):
@@ -46,7 +60,15 @@ def score_columns(rows: list[dict], pair) -> list[str]:
                         key=lambda s: (s != pair.primary_structure, s))
     cols = []
     for s in structures:
-        cols += [f"dice:{s}", f"hd95:{s}", f"hd:{s}"]
+        if pair.landmarks_by_kind:
+            # Phantom suite: the body outline never changes; HD (the maximum) is in results.csv.
+            if s != "body":
+                cols += [f"dice:{s}", f"hd95:{s}"]
+        else:
+            cols += [f"dice:{s}", f"hd95:{s}", f"hd:{s}"]
+    kinds = sorted({k.split(":", 1)[1] for r in rows for k in r if k.startswith("tre_mean_mm:")},
+                   key=lambda k: (KIND_ORDER.index(k) if k in KIND_ORDER else 99, k))
+    cols[0:0] = [f"tre_mean_mm:{k}" for k in kinds]
     if any("tre_mean_mm" in r for r in rows):
         cols.insert(0, "tre_mean_mm")
     cols += ["jacobian_nonpositive_fraction", "ic_mean_mm", "seconds"]
@@ -54,6 +76,8 @@ def score_columns(rows: list[dict], pair) -> list[str]:
 
 
 def column_label(c: str) -> str:
+    if c.startswith("tre_mean_mm:"):
+        return f"{c.split(':', 1)[1]} TRE mm"
     if ":" in c:
         kind, s = c.split(":", 1)
         return f"{s} {'Dice' if kind == 'dice' else kind.upper() + ' mm'}"
@@ -95,11 +119,9 @@ def summary_rows(chosen: dict, baseline: dict | None, cols: list[str]) -> list[d
     if baseline:
         rows.append({"method": "rigid baseline", "config": "", "n": 1,
                      **{c: baseline.get(c) for c in cols}})
-    for m in ("morea", "elastix", "ants"):
-        if m not in chosen:
-            continue
+    for m in method_keys(chosen):
         cfg, rs = chosen[m]
-        row = {"method": METHOD_LABEL[m], "config": cfg, "n": len(rs)}
+        row = {"method": method_label(m), "config": cfg, "n": len(rs)}
         for c in cols:
             vals = [r[c] for r in rs if r.get(c) is not None]
             if vals:
@@ -127,7 +149,8 @@ def parallel_coordinates(path: Path, chosen: dict, baseline: dict | None, pair,
         return
     series = []
     colors = {"morea": "tab:red", "elastix": "tab:blue", "ants": "tab:green"}
-    for m, (cfg, rs) in chosen.items():
+    for m in method_keys(chosen):
+        cfg, rs = chosen[m]
         for r in rs:
             series.append((m, [r.get(c, np.nan) for c in cols]))
     if baseline:
@@ -143,8 +166,8 @@ def parallel_coordinates(path: Path, chosen: dict, baseline: dict | None, pair,
     fig, ax = plt.subplots(figsize=(1.6 * len(cols) + 2, 3.6), dpi=80)
     seen = set()
     for (m, _), y in zip(series, norm):
-        label = METHOD_LABEL.get(m, m)
-        ax.plot(range(len(cols)), y, color=colors.get(m, "black"),
+        label = method_label(m)
+        ax.plot(range(len(cols)), y, color=colors.get(m, "tab:orange"),
                 ls="--" if m == "rigid baseline" else "-", alpha=0.8, marker="o", ms=3,
                 label=None if label in seen else label)
         seen.add(label)
@@ -173,12 +196,19 @@ def renders(study, chosen: dict) -> dict:
         evaluation.evaluate(study.morea, study.problem, rdir / "baseline.json",
                             render=base_prefix, focus=focus)
     out["rigid baseline"] = base_prefix
-    for m, (cfg, rs) in chosen.items():
+    for m in method_keys(chosen):
+        cfg, rs = chosen[m]
+        method = m.split(":", 1)[0]
         seed = min(r["seed"] for r in rs)
-        d = study.run_dir(m, None if m == "morea" else float(cfg[1:]), seed)
-        prefix = rdir / f"{m}_{cfg}_seed{seed}"
+        d = study.config_dir(method, cfg, seed)
+        # MOREA runs made on a GPU (bench/run-study-morea.sh) bring their renders
+        # under this name instead of their fields.
+        prefix = rdir / f"{method}_{cfg}_seed{seed}"
         if not Path(str(prefix) + "_coronal.png").exists():
-            evaluation.evaluate(study.morea, study.problem, rdir / f"{m}.json",
+            if not (d / "fixed_to_moving.nii.gz").exists():
+                study.say(f"renders: {d.relative_to(study.out)} has neither fields nor renders")
+                continue
+            evaluation.evaluate(study.morea, study.problem, rdir / f"{method}.json",
                                 d / "fixed_to_moving.nii.gz", d / "moving_to_fixed.nii.gz",
                                 render=prefix, focus=focus)
         out[m] = prefix
@@ -192,7 +222,8 @@ def render_montage(path: Path, rend: dict) -> None:
     matplotlib.use("Agg")
     import matplotlib.image as mpimg
     import matplotlib.pyplot as plt
-    order = [k for k in ("rigid baseline", "morea", "elastix", "ants") if k in rend]
+    order = ["rigid baseline"] if "rigid baseline" in rend else []
+    order += method_keys({k: None for k in rend if k != "rigid baseline"})
     views = ("axial", "coronal", "sagittal")
     fig, axes = plt.subplots(len(views), len(order), figsize=(2.2 * len(order), 6.2), dpi=90,
                              squeeze=False)
@@ -205,10 +236,66 @@ def render_montage(path: Path, rend: dict) -> None:
             ax.set_xticks([])
             ax.set_yticks([])
             if i == 0:
-                ax.set_title(f"{METHOD_LABEL.get(k, k)}\n{Path(str(rend[k])).name}", fontsize=7)
+                ax.set_title(f"{method_label(k)}\n{Path(str(rend[k])).name}", fontsize=7)
     fig.tight_layout()
     fig.savefig(path)
     plt.close(fig)
+
+
+def acceptance(pair, chosen: dict) -> list[dict]:
+    """The phantom suite's acceptance checks (issue 48) on the medians over seeds:
+    MOREA's mean TRE <= ANTs SyN's + 0.2 mm; bladder Dice >= ANTs SyN's; bone TRE
+    <= 0.5 mm with and without bones guiding (every seed); no voxel with
+    Jacobian determinant <= 0 (every MOREA run)."""
+    if not pair.phantom_case or "morea" not in chosen:
+        return []
+    checks = []
+
+    def values(key, col):
+        return [r[col] for r in chosen[key][1] if r.get(col) is not None] if key in chosen else []
+
+    def med(key, col):
+        v = values(key, col)
+        return float(np.median(v)) if v else None
+
+    m_tre, a_tre = med("morea", "tre_mean_mm"), med("ants", "tre_mean_mm")
+    if m_tre is not None and a_tre is not None:
+        checks.append({"check": "mean TRE (all landmarks) <= ANTs SyN + 0.2 mm",
+                       "MOREA": m_tre, "reference": a_tre + 0.2,
+                       "passed": m_tre <= a_tre + 0.2})
+    m_d, a_d = med("morea", "dice:bladder"), med("ants", "dice:bladder")
+    if m_d is not None and a_d is not None:
+        checks.append({"check": "bladder Dice >= ANTs SyN", "MOREA": m_d, "reference": a_d,
+                       "passed": m_d >= a_d})
+    for key in [k for k in method_keys(chosen) if k.startswith("morea")]:
+        v = values(key, "tre_mean_mm:bone")
+        if v:
+            checks.append({"check": f"bone TRE <= 0.5 mm, {method_label(key)}, worst seed",
+                           "MOREA": float(np.max(v)), "reference": 0.5,
+                           "passed": float(np.max(v)) <= 0.5})
+        j = values(key, "jacobian_nonpositive_fraction")
+        if j:
+            checks.append({"check": f"no voxel with Jacobian <= 0, {method_label(key)}, worst seed",
+                           "MOREA": float(np.max(j)), "reference": 0.0,
+                           "passed": float(np.max(j)) == 0.0})
+    return checks
+
+
+def profile_lines(study) -> list[str]:
+    st = study.settings
+    e, a = st.get("elastix", {}), st.get("ants", {})
+    lines = [f"Competitors' budget profile: **{study.profile_name}**."]
+    if e:
+        lines.append(f"- elastix: {e.get('iterations')} iterations per resolution (4 resolutions, "
+                     f"mask step and image step), {e.get('spatial_samples')} random samples, "
+                     f"final B-spline grid {e.get('grid_spacing')} mm, step-size estimation "
+                     f"{e.get('parameter_estimation')}; weights {e.get('weights')}.")
+    if a:
+        lines.append(f"- ANTs SyN: iterations {'x'.join(str(i) for i in a.get('iterations', ()))} "
+                     f"(caps; convergence window 10, threshold 1e-6), CC radius "
+                     f"{a.get('cc_radius')} voxels, gradient step 1.0, update regularisation "
+                     f"4.0; total regularisation {a.get('weights')}.")
+    return lines
 
 
 def write_all(study, rows: list[dict], chosen: dict) -> None:
@@ -222,6 +309,10 @@ def write_all(study, rows: list[dict], chosen: dict) -> None:
                                      for k, v in r.items()} for r in summ])
     tests = mann_whitney(chosen, pair)
     write_csv(out / "tests.csv", tests)
+    conv = study.convergence()
+    write_csv(out / "convergence.csv", conv)
+    checks = acceptance(pair, chosen)
+    write_csv(out / "acceptance.csv", checks)
     parallel_coordinates(out / "parallel_coordinates.png", chosen, baseline, pair, rows)
     try:
         rend = renders(study, chosen)
@@ -235,6 +326,10 @@ def write_all(study, rows: list[dict], chosen: dict) -> None:
               f"{study.args.threads} threads per run; mode: {'quick' if study.args.quick else 'full'}.")
     md.append(f"Problem: `{study.problem}` (preprocessed with `{pair.morea_parameters.name}`); "
               f"every method scored by `morea evaluate` on it.")
+    md += profile_lines(study)
+    hosts = sorted({str(common_host(study, r)) for r in rows if r.get("method") == "morea"} - {"None"})
+    if hosts:
+        md.append(f"MOREA ran on: {', '.join(hosts)}.")
     md.append("")
     md.append("## Chosen configurations (median over seeds; min-max in summary.csv)")
     header = ["method", "config", "n"] + [column_label(c) for c in cols]
@@ -248,13 +343,50 @@ def write_all(study, rows: list[dict], chosen: dict) -> None:
                                t["p_value"], "yes" if t["significant_at_0.025"] else "no",
                                t["direction"]] for t in tests]))
     md.append("")
+    if checks:
+        md.append("## Acceptance (phantom suite; medians over seeds unless stated)")
+        md.append(markdown_table(["check", "MOREA", "reference", "passed"],
+                                 [[c["check"], c["MOREA"], c["reference"],
+                                   "yes" if c["passed"] else "NO"] for c in checks]))
+        md.append("")
+    if conv:
+        md.append(f"## Convergence check (best configuration, seed 1, twice the iterations; "
+                  f"converged: |change| of {pair.criteria[0].label} < 1 %)")
+        md.append(markdown_table(
+            ["method", "config", "iterations", "used", "score", "iterations x2", "used x2",
+             "score x2", "relative change", "converged", "time s", "time x2 s"],
+            [[METHOD_LABEL[c["method"]], c["config"], _iters(c["iterations"]),
+              _iters(c["iterations_used"]), c["score_at_budget"], _iters(c["iterations_doubled"]),
+              _iters(c["iterations_used_doubled"]), c["score_doubled"],
+              (None if c["relative_change"] is None else f"{100 * c['relative_change']:.2f} %"),
+              "yes" if c["converged"] else "NO", c["seconds"], c["seconds_doubled"]]
+             for c in conv]))
+        md.append("")
     md.append("## Regularisation sweep (seed 1)")
-    sweep = [r for r in rows if r["method"] in ("elastix", "ants") and r.get("seed") == 1]
+    sweep = [r for r in rows if r["method"] in ("elastix", "ants") and r.get("seed") == 1
+             and "-x" not in str(r.get("config"))]
     md.append(markdown_table(["method", "config"] + [column_label(c) for c in cols],
                              [[METHOD_LABEL[r["method"]], r["config"]] +
                               [("FAILED" if r.get("failed") else r.get(c)) for c in cols]
                               for r in sorted(sweep, key=lambda r: (r["method"], r["config"]))]))
     md.append("")
     md.append("## All runs: results.csv. Renders: " +
-              ", ".join(f"{METHOD_LABEL.get(k, k)} `{Path(v).name}_*.png`" for k, v in rend.items()))
+              ", ".join(f"{method_label(k)} `{Path(v).name}_*.png`" for k, v in rend.items()))
     (out / "report.md").write_text("\n".join(md) + "\n")
+
+
+def _iters(v):
+    if v is None:
+        return ""
+    if isinstance(v, (list, tuple)):
+        return "x".join(str(i) for i in v)
+    return str(v)
+
+
+def common_host(study, row):
+    d = study.config_dir("morea", row["config"], row["seed"]) if row.get("seed") else None
+    if d is None or not (d / "run.json").exists():
+        return None
+    import json
+    rec = json.loads((d / "run.json").read_text())
+    return rec.get("host") or (f"this machine ({rec.get('backend')})" if rec.get("backend") else None)
