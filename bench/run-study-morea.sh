@@ -36,6 +36,11 @@
 #                                run 10 minutes); what is left is for another call
 #   MOREA_STUDY_TAG=NAME         names the outputs (default: the pairs and seeds)
 #   MOREA_STUDY_KEEP_FIELDS=1    also keep both fields of the first seed (a few MB each)
+#   MOREA_STUDY_FRONT=1          write every front member and score each (study/front_scores.py):
+#                                front_scores.csv per run, TRE and Dice along the whole front
+#   MOREA_STUDY_SET="K=V ..."    an experiment outside the study: these overrides on every run,
+#   MOREA_STUDY_LABEL=NAME       whose results go to configuration VARIANT-NAME (required with
+#                                MOREA_STUDY_SET, so that they never mix with the study's runs)
 #   MOREA_STUDY_WORK=/tmp/study-morea   scratch (runs finished there are not redone
 #                                while the machine stays the same)
 #   MOREA_BIN, MOREA_BUNDLE_DIR  a morea binary / unpacked bundle (default /tmp/b, unpacked
@@ -92,6 +97,12 @@ case "${1:-}" in
     results="$work/results"
     mkdir -p "$results" "$work/raw" "$work/reg"
     deadline=${MOREA_STUDY_DEADLINE_S:-540}
+    label=${MOREA_STUDY_LABEL:+-$MOREA_STUDY_LABEL}
+    if [ -n "${MOREA_STUDY_SET:-}" ] && [ -z "$label" ]; then
+      echo "MOREA_STUDY_SET needs MOREA_STUDY_LABEL (an experiment's runs are kept apart)" >&2; exit 2
+    fi
+    select=best-guidance,knee
+    [ "${MOREA_STUDY_FRONT:-0}" = 1 ] && select=best-guidance,knee,all
     pairs_sel=${MOREA_STUDY_PAIRS:-}
     if [ -z "$pairs_sel" ]; then
       for j in "$bundle"/data/*/morea_job.json; do pairs_sel="$pairs_sel $(basename "$(dirname "$j")")"; done
@@ -138,8 +149,9 @@ case "${1:-}" in
         [ $stop = 0 ] || break
         extra=()
         while IFS= read -r a; do [ -n "$a" ] && extra+=("$a"); done < <(jq_ "$job" "'\n'.join(d['variants']['$variant'])")
+        for o in ${MOREA_STUDY_SET:-}; do extra+=(--set "$o"); done
         for seed in $seeds; do
-          rd="$results/$pair/runs/morea/$variant/seed$seed"
+          rd="$results/$pair/runs/morea/$variant$label/seed$seed"
           if [ -f "$rd/scores.json" ]; then continue; fi
           now=$(( $(date +%s) - t0 ))
           if [ $(( now + last + last / 5 )) -gt "$deadline" ]; then
@@ -151,10 +163,10 @@ case "${1:-}" in
           rm -rf "$reg" "$rd"
           mkdir -p "$rd"
           cmd=("$morea" register "${raw_args[@]}" --parameters "$pd/morea_parameters.toml" --set "seed=$seed"
-               "${extra[@]}" --select best-guidance,knee --checkpoint-every 0)
+               "${extra[@]}" --select "$select" --checkpoint-every 0)
           [ -n "$init" ] && cmd+=(--initial-transform "$pd/$init")
           cmd+=(-o "$reg")
-          say "$pair $variant seed $seed"
+          say "$pair $variant$label seed $seed"
           s0=$(date +%s.%N)
           if ! "${cmd[@]}" >"$work/reg/$pair-$variant-$seed.log" 2>&1; then
             say "  FAILED (morea register), see the log in the archive"
@@ -189,14 +201,18 @@ case "${1:-}" in
             cp "$rd/scores.main.json" "$rd/scores.json.tmp"
           fi
           rm -f "$rd"/scores.*.json
-          python3 -m study.morea_record record "$reg" "$rd/run.json" --seed "$seed" --config "$variant" \
+          python3 -m study.morea_record record "$reg" "$rd/run.json" --seed "$seed" --config "$variant$label" \
             --parameters "study/params/$(jq_ "$job" "d['parameters_source']")" --seconds "$seconds" \
             --host "$host" --extra-args "${extra[*]:-}"
           cp "$reg/front.csv" "$rd/"
+          if [ "${MOREA_STUDY_FRONT:-0}" = 1 ]; then
+            python3 -m study.front_scores "$reg" "$pd/problem" "$rd/front_scores.csv" --morea "$morea" \
+              ${kinds:+--landmarks "$pd/landmarks"} 2>>"$log" || say "  front scores failed (see the log)"
+          fi
           if [ "$seed" = "$first_seed" ]; then
             mkdir -p "$results/$pair/renders"
             "$morea" evaluate --problem "$pd/problem" --field "$sol/preprocessed_fixed_to_moving.nii.gz" \
-              --render "$results/$pair/renders/morea_${variant}_seed${seed}" --focus "$focus" >>"$log" 2>&1 || true
+              --render "$results/$pair/renders/morea_${variant}${label}_seed${seed}" --focus "$focus" >>"$log" 2>&1 || true
             if [ "${MOREA_STUDY_KEEP_FIELDS:-0}" = 1 ]; then
               cp "$sol/preprocessed_fixed_to_moving.nii.gz" "$rd/fixed_to_moving.nii.gz"
               cp "$sol/preprocessed_moving_to_fixed.nii.gz" "$rd/moving_to_fixed.nii.gz"
@@ -214,7 +230,7 @@ print(",".join(f(v) for v in (r.get("backend"), (s.get("landmarks") or {}).get("
       s.get("jacobian_nonpositive_fraction"))))
 EOF_PY
 )
-          echo "$pair,$variant,$seed,$seconds,$line,ok" >>"$csv"
+          echo "$pair,$variant$label,$seed,$seconds,$line,ok" >>"$csv"
           say "  $seconds s: $line"
           rm -rf "$reg" "$work/reg/$pair-$variant-$seed.log"
           pack

@@ -88,6 +88,60 @@ TEST(MeshPointPlacement, MaskBoundaryPointsOfACube)
   EXPECT_EQ(morea_core::MaskBoundaryPoints(mask).size(), 26u); // 27 voxels minus the centre
 }
 
+TEST(MeshPointPlacement, DistanceToMaskIsTheExactEuclideanDistance)
+{
+  // Anisotropic voxels and a scattered mask: every voxel's distance equals the
+  // brute-force distance to the nearest mask voxel centre.
+  morea_core::Volume<std::uint8_t> mask({ { 9, 7, 6 } }, { { 1.0, 1.5, 2.5 } }, { { -3, 2, 1 } });
+  morea_core::RandomGenerator      random(11);
+  std::vector<Vec3>                inside;
+  for (std::size_t k = 0; k < 6; ++k)
+    for (std::size_t j = 0; j < 7; ++j)
+      for (std::size_t i = 0; i < 9; ++i)
+        if (random.Uniform() < 0.06)
+        {
+          mask(i, j, k) = 1;
+          inside.push_back(mask.PointAt(i, j, k));
+        }
+  ASSERT_GT(inside.size(), 2u);
+  const auto distance = morea_core::DistanceToMask(mask);
+  for (std::size_t k = 0; k < 6; ++k)
+    for (std::size_t j = 0; j < 7; ++j)
+      for (std::size_t i = 0; i < 9; ++i)
+      {
+        double best = 1e300;
+        for (const Vec3 & q : inside)
+          best = std::min(best, Distance(mask.PointAt(i, j, k), q));
+        ASSERT_NEAR(distance(i, j, k), best, 1e-5) << i << " " << j << " " << k;
+      }
+  // No mask: no distance.
+  const morea_core::Volume<std::uint8_t> empty({ { 3, 3, 3 } }, { { 1, 1, 1 } }, { { 0, 0, 0 } });
+  EXPECT_TRUE(std::isinf(morea_core::DistanceToMask(empty)(1, 1, 1)));
+}
+
+TEST(MeshPointPlacement, ShellPointsLieAtTheirDistanceAroundABall)
+{
+  morea_core::Volume<std::uint8_t> ball({ { 41, 41, 41 } }, { { 1.5, 1.5, 1.5 } }, { { -30, -30, -30 } });
+  for (std::size_t k = 0; k < 41; ++k)
+    for (std::size_t j = 0; j < 41; ++j)
+      for (std::size_t i = 0; i < 41; ++i)
+        ball(i, j, k) = Distance(ball.PointAt(i, j, k), { { 0, 0, 0 } }) <= 10.0 ? 1 : 0;
+  const auto distance = morea_core::DistanceToMask(ball);
+  for (const double offset : { 4.0, 12.0 })
+  {
+    const auto shell = morea_core::ShellPoints(distance, offset);
+    ASSERT_GT(shell.size(), 100u);
+    for (const Vec3 & p : shell)
+    {
+      // The ball's voxel centres reach 10 mm; the shell lies offset +- half a voxel outside them.
+      const double r = Distance(p, { { 0, 0, 0 } });
+      EXPECT_GT(r, 10.0 + offset - 0.75 - 1.5) << offset;
+      EXPECT_LT(r, 10.0 + offset + 0.75 + 1e-9) << offset;
+    }
+  }
+  EXPECT_TRUE(morea_core::ShellPoints(distance, 100.0).empty()); // outside the grid
+}
+
 TEST(Tetrahedralization, DelaunayOfACubeTilesIt)
 {
   morea_core::MeshDomain d;
@@ -157,6 +211,84 @@ TEST(MeshGenerator, OptionsFollowTheMethodName)
   EXPECT_THROW(morea_core::MeshGeneratorOptions::FromParameters(p), morea_core::Error);
 }
 
+TEST(MeshGenerator, ShellOptionsFromParameters)
+{
+  morea_core::ParameterSet p;
+  auto                     o = morea_core::MeshGeneratorOptions::FromParameters(p);
+  EXPECT_EQ(o.shellOffsets, (std::vector<double>{ 8.0, 20.0 })); // the default
+  EXPECT_DOUBLE_EQ(o.shellFraction, 0.15);
+  EXPECT_EQ(o.shellStructures, (std::vector<std::string>{ "bladder" }));
+  p.SetFromString("morea_mesh_shell_offsets", "5,12.5, 30");
+  p.SetFromString("morea_mesh_shell_fraction", "0.2");
+  p.SetFromString("morea_mesh_surface_structures", "stomach, bladder");
+  o = morea_core::MeshGeneratorOptions::FromParameters(p);
+  EXPECT_EQ(o.shellOffsets, (std::vector<double>{ 5.0, 12.5, 30.0 }));
+  EXPECT_DOUBLE_EQ(o.shellFraction, 0.2);
+  EXPECT_EQ(o.shellStructures, (std::vector<std::string>{ "stomach", "bladder" }));
+  p.SetFromString("morea_mesh_shell_offsets", "");
+  EXPECT_TRUE(morea_core::MeshGeneratorOptions::FromParameters(p).shellOffsets.empty());
+  for (const char * bad : { "x", "8 mm", "0", "-4", "inf" })
+  {
+    p.SetFromString("morea_mesh_shell_offsets", bad);
+    EXPECT_THROW(morea_core::MeshGeneratorOptions::FromParameters(p), morea_core::Error) << bad;
+  }
+}
+
+TEST(MeshGenerator, ShellsAroundTheBladder)
+{
+  const auto &                           pm = morea_test::PhantomMesh600();
+  std::vector<morea_core::MeshStructure> structures;
+  for (std::size_t s = 1; s < pm.names.size(); ++s)
+    structures.push_back({ pm.names[s], morea_core::MaskBoundaryPoints(pm.phantomCase.movingMasks[s]),
+                           &pm.phantomCase.movingMasks[s] });
+  morea_core::MeshGeneratorOptions options;
+  options.seed = 7;
+  options.shellOffsets = { 6.0, 15.0 };
+  options.shellFraction = 0.2;
+  morea_core::MeshGenerationReport report;
+  const auto mesh = morea_core::GenerateMesh(pm.domain, structures, options, &report);
+  for (const auto & note : report.notes)
+    ADD_FAILURE() << note;
+  EXPECT_EQ(report.shellPoints, 120u);
+  EXPECT_EQ(report.corners + report.boundaryPoints + report.randomPoints + report.refinementPoints +
+              report.contourPoints + report.surfacePoints + report.shellPoints,
+            600u);
+  EXPECT_EQ(report.randomPoints + report.refinementPoints + report.boundaryPoints, 60u);
+  // Shell points sit at one of the offsets from the bladder, not on any structure.
+  const auto & bladder = pm.phantomCase.movingMasks[2];
+  ASSERT_EQ(pm.names[2], "bladder");
+  const auto   distance = morea_core::DistanceToMask(bladder);
+  const double half = 0.5 * bladder.spacing[0];
+  std::size_t  shell = 0, onShell = 0;
+  for (std::size_t i = 0; i < mesh.origins.size(); ++i)
+  {
+    if (mesh.origins[i] != morea_core::PointOrigin::Shell)
+      continue;
+    ++shell;
+    EXPECT_EQ(mesh.structures[i], -1);
+    double nearest = 1e300;
+    for (std::size_t k = 0; k < bladder.size[2]; ++k)
+      for (std::size_t j = 0; j < bladder.size[1]; ++j)
+        for (std::size_t v = 0; v < bladder.size[0]; ++v)
+          if (bladder(v, j, k) != 0)
+            nearest = std::min(nearest, Distance(mesh.points[i], bladder.PointAt(v, j, k)));
+    onShell += std::abs(nearest - 6.0) <= half + 1e-9 || std::abs(nearest - 15.0) <= half + 1e-9;
+    EXPECT_GT(nearest, 0.0); // never inside the bladder
+  }
+  EXPECT_EQ(shell, 120u);
+  // Sliver removal moves a few of them (they are as free as random points).
+  EXPECT_GE(onShell, 100u);
+  for (const auto & t : mesh.tetrahedra)
+    ASSERT_GT(morea_core::SignedVolume(t, mesh.points), 0.0);
+
+  // No shell structure among the structures: a note, and the points go to the rest.
+  options.shellStructures = { "stomach" };
+  morea_core::MeshGenerationReport none;
+  morea_core::GenerateMesh(pm.domain, structures, options, &none);
+  EXPECT_EQ(none.shellPoints, 0u);
+  EXPECT_EQ(none.notes.size(), 1u);
+}
+
 TEST(MeshGenerator, PhantomMeshWithBladderSurface)
 {
   const auto & pm = morea_test::PhantomMesh600();
@@ -165,7 +297,10 @@ TEST(MeshGenerator, PhantomMeshWithBladderSurface)
   for (const auto & note : r.notes)
     ADD_FAILURE() << note;
   EXPECT_EQ(mesh.NumberOfPoints(), 600u + r.steinerPoints);
-  EXPECT_EQ(r.corners + r.boundaryPoints + r.randomPoints + r.refinementPoints + r.contourPoints + r.surfacePoints, 600u);
+  EXPECT_EQ(r.corners + r.boundaryPoints + r.randomPoints + r.refinementPoints + r.contourPoints + r.surfacePoints +
+              r.shellPoints,
+            600u);
+  EXPECT_EQ(r.shellPoints, 90u); // 15 % on the default shells around the bladder
   EXPECT_GT(r.surfacePoints, 50u);
   EXPECT_GT(r.contourPoints, 300u);
   EXPECT_EQ(r.randomPoints + r.refinementPoints + r.boundaryPoints, 60u);
@@ -214,7 +349,7 @@ TEST(MeshGenerator, PhantomMeshWithBladderSurface)
   EXPECT_EQ(fixed, 8u);
 
   std::cout << "phantom mesh: " << mesh.NumberOfPoints() << " points (" << r.surfacePoints << " surface, "
-            << r.contourPoints << " contour, " << r.randomPoints << " random, " << r.refinementPoints
+            << r.contourPoints << " contour, " << r.shellPoints << " shell, " << r.randomPoints << " random, " << r.refinementPoints
             << " refinement, " << r.boundaryPoints << " on faces, " << r.steinerPoints << " Steiner), "
             << mesh.NumberOfTetrahedra() << " tetrahedra (" << r.slivers << " of quality < 0.05, worst "
             << r.worstQuality << "); placement "

@@ -39,6 +39,15 @@ struct MeshGeneratorOptions
    *  tetrahedra) that fold at the slightest move. */
   double                        refinementFraction{ 0.5 };
   std::vector<std::string>      surfaceStructures{ "bladder" };
+  /** Shells around the deforming organs: points at these distances (mm)
+   *  outside each of shellStructures, a share shellFraction of all points.
+   *  Soft tissue next to an organ that fills or empties moves with it, and
+   *  its motion decays within a few centimetres; without points there, one
+   *  tetrahedron spans from the organ's wall to tissue far away and carries
+   *  the wall's motion into it (bench/results/mesh-shells.md). Empty: no shells. */
+  std::vector<double>           shellOffsets{ 8.0, 20.0 };
+  double                        shellFraction{ 0.15 };
+  std::vector<std::string>      shellStructures{ "bladder" };
   std::map<std::string, double> shares;                    ///< per structure, default 1
   std::uint64_t                 seed{ 0 };
   /** How TetGen runs (by default each run in a child process, so that its
@@ -63,6 +72,7 @@ struct MeshGenerationReport
   double                                            worstQuality{ 0.0 }; ///< lowest TetrahedronQuality
   std::size_t                                       slivers{ 0 };        ///< tetrahedra of quality < 0.05
   std::size_t                                       contourPoints{ 0 };
+  std::size_t                                       shellPoints{ 0 };
   std::size_t                                       surfacePoints{ 0 };
   std::size_t                                       surfaceTriangles{ 0 };
   std::size_t                                       steinerPoints{ 0 };

@@ -6,6 +6,7 @@
 
 #include "morea_core/Random.h"
 #include "morea_core/TetrahedralMesh.h"
+#include "morea_core/Volume.h"
 
 #include <cstddef>
 #include <cstdint>
@@ -36,6 +37,20 @@ BestCandidateRandomPoints(std::size_t count, const std::function<Vec3(RandomGene
  *  on the grid's border): the structure's contour points. */
 std::vector<Vec3>
 MaskBoundaryPoints(const Volume<std::uint8_t> & mask);
+
+/** Per voxel, the distance in mm from its centre to the nearest centre of a
+ *  mask voxel (0 inside the mask; infinity everywhere when the mask is
+ *  empty): the exact Euclidean distance transform, one axis at a time
+ *  (Felzenszwalb and Huttenlocher 2012), with the mask's spacing. */
+Volume<float>
+DistanceToMask(const Volume<std::uint8_t> & mask);
+
+/** Centres of the voxels outside a mask whose distance to it (`distance`,
+ *  from DistanceToMask) is within half the largest voxel spacing of `offset`
+ *  mm: candidates for points on a shell around a structure. Empty when the
+ *  shell leaves the grid. */
+std::vector<Vec3>
+ShellPoints(const Volume<float> & distance, double offset);
 
 /** The 8 corners of the domain. */
 std::vector<Vec3>

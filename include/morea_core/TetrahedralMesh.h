@@ -71,7 +71,8 @@ enum class PointOrigin : std::int8_t
   Surface,   ///< a vertex of a constraining structure surface
   Steiner,   ///< added by the tetrahedraliser to recover a surface
   Refinement, ///< at the circumcentre of a poorly shaped tetrahedron (removes slivers)
-  Midpoint    ///< of an edge bisected between mesh resolution levels (MeshRefinement.h)
+  Midpoint,   ///< of an edge bisected between mesh resolution levels (MeshRefinement.h)
+  Shell       ///< on a shell at a set distance around a structure (MeshGeneratorOptions::shellOffsets)
 };
 
 /** The base mesh: one configuration of points plus topology and boundary pins. */

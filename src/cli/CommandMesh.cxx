@@ -37,6 +37,7 @@ ReportToJson(const itk::morea::MeshModel & model)
   j["slivers"] = g.slivers;
   j["worst_quality"] = g.worstQuality;
   j["points_by_origin"]["refinement"] = g.refinementPoints;
+  j["points_by_origin"]["shell"] = g.shellPoints;
   j["edges"] = model.topology.Edges().size();
   j["fos_elements"] = model.report.fosElements;
   j["parallel_groups"] = model.report.parallelGroups;

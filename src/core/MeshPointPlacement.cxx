@@ -25,7 +25,110 @@ SquaredDistanceToSet(const Vec3 & p, const std::vector<Vec3> & set)
     best = std::min(best, SquaredDistance(p, q));
   return best;
 }
+
+/** One line of the squared distance transform: f holds squared distances (or
+ *  infinity) at samples `step` mm apart; on return, the lower envelope of the
+ *  parabolas (x - q)^2 + f(q). */
+void
+SquaredDistanceLine(std::vector<double> & f, double step, std::vector<double> & out, std::vector<std::size_t> & v,
+                    std::vector<double> & z)
+{
+  const std::size_t n = f.size();
+  const double      inf = std::numeric_limits<double>::infinity();
+  out.assign(n, inf);
+  v.assign(n, 0);
+  z.assign(n + 1, 0.0);
+  std::size_t k = 0;
+  bool        any = false;
+  for (std::size_t q = 0; q < n; ++q)
+  {
+    if (!std::isfinite(f[q]))
+      continue;
+    if (!any)
+    {
+      any = true;
+      v[0] = q;
+      z[0] = -inf;
+      z[1] = inf;
+      continue;
+    }
+    const double xq = step * static_cast<double>(q);
+    double s = 0.0;
+    for (;;) // z[0] is -infinity, so k never drops below 0
+    {
+      const double xv = step * static_cast<double>(v[k]);
+      s = ((f[q] + xq * xq) - (f[v[k]] + xv * xv)) / (2.0 * (xq - xv));
+      if (s > z[k])
+        break;
+      --k;
+    }
+    ++k;
+    v[k] = q;
+    z[k] = s;
+    z[k + 1] = inf;
+  }
+  if (!any)
+    return;
+  k = 0;
+  for (std::size_t q = 0; q < n; ++q)
+  {
+    const double x = step * static_cast<double>(q);
+    while (z[k + 1] < x)
+      ++k;
+    const double d = x - step * static_cast<double>(v[k]);
+    out[q] = d * d + f[v[k]];
+  }
+}
 } // namespace
+
+Volume<float>
+DistanceToMask(const Volume<std::uint8_t> & mask)
+{
+  const auto &        n = mask.size;
+  const double        inf = std::numeric_limits<double>::infinity();
+  std::vector<double> squared(mask.NumberOfVoxels());
+  for (std::size_t i = 0; i < squared.size(); ++i)
+    squared[i] = mask.data[i] != 0 ? 0.0 : inf;
+  std::vector<double>      line, out, z;
+  std::vector<std::size_t> v;
+  const std::size_t        stride[3] = { 1, n[0], n[0] * n[1] };
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    const int a = (axis + 1) % 3, b = (axis + 2) % 3;
+    line.resize(n[axis]);
+    for (std::size_t j = 0; j < n[b]; ++j)
+      for (std::size_t i = 0; i < n[a]; ++i)
+      {
+        const std::size_t base = i * stride[a] + j * stride[b];
+        for (std::size_t q = 0; q < n[axis]; ++q)
+          line[q] = squared[base + q * stride[axis]];
+        SquaredDistanceLine(line, mask.spacing[axis], out, v, z);
+        for (std::size_t q = 0; q < n[axis]; ++q)
+          squared[base + q * stride[axis]] = out[q];
+      }
+  }
+  Volume<float> distance = mask.template Like<float>(0.0f);
+  for (std::size_t i = 0; i < squared.size(); ++i)
+    distance.data[i] = static_cast<float>(std::sqrt(squared[i]));
+  return distance;
+}
+
+std::vector<Vec3>
+ShellPoints(const Volume<float> & distance, double offset)
+{
+  const double      half = 0.5 * std::max({ distance.spacing[0], distance.spacing[1], distance.spacing[2] });
+  std::vector<Vec3> points;
+  const auto &      n = distance.size;
+  for (std::size_t k = 0; k < n[2]; ++k)
+    for (std::size_t j = 0; j < n[1]; ++j)
+      for (std::size_t i = 0; i < n[0]; ++i)
+      {
+        const double d = distance(i, j, k);
+        if (d > 0.0 && std::abs(d - offset) <= half)
+          points.push_back(distance.PointAt(i, j, k));
+      }
+  return points;
+}
 
 std::vector<Vec3>
 SpreadOutSubset(const std::vector<Vec3> & candidates, std::size_t count, const std::vector<Vec3> & existing,

@@ -78,6 +78,10 @@ MakeSpecs()
          "structures whose surface constrains the mesh (comma-separated; used by methods naming 'bladder')"),
     Text("morea_mesh_structure_shares", "", {},
          "share of contour points per structure, e.g. \"bladder=2, bones=1\" (unnamed structures: 1)"),
+    Text("morea_mesh_shell_offsets", "8, 20", {},
+         "distances in mm outside the structures of morea_mesh_surface_structures at which shells of mesh "
+         "points are placed (comma-separated, e.g. \"8, 20\"; empty: none)"),
+    Real("morea_mesh_shell_fraction", 0.15, 0.0, 0.9, "fraction of the mesh points on the shells, when any"),
     Real("morea_mesh_boundary_fraction", 0.25, 0.0, 1.0,
          "fraction of the random mesh points placed on the domain's faces (they slide within them)"),
     Text("morea_elasticity_factors", "bones=10, bladder=0.5", {},

@@ -210,7 +210,7 @@ RemoveSlivers(PointSet & set, TetrahedralizationResult & tet,
       const Vec3 * p[4] = { &tet.points[v[0]], &tet.points[v[1]], &tet.points[v[2]], &tet.points[v[3]] };
       if (TetrahedronQuality(*p[0], *p[1], *p[2], *p[3]) >= kSliverQuality)
         continue;
-      // The freest vertex: random or refinement, then face, then contour points.
+      // The freest vertex: random, refinement or shell, then face, then contour points.
       int best = -1, bestRank = 99;
       for (int k = 0; k < 4; ++k)
       {
@@ -218,9 +218,9 @@ RemoveSlivers(PointSet & set, TetrahedralizationResult & tet,
         if (i >= set.points.size() || moved[i])
           continue;
         const PointOrigin o = set.origins[i];
-        const int rank = (o == PointOrigin::Random || o == PointOrigin::Refinement) ? 0
-                         : o == PointOrigin::BoundaryFace                          ? 1
-                         : o == PointOrigin::Contour                               ? 2
+        const int rank = (o == PointOrigin::Random || o == PointOrigin::Refinement || o == PointOrigin::Shell) ? 0
+                         : o == PointOrigin::BoundaryFace                                                 ? 1
+                         : o == PointOrigin::Contour                                                      ? 2
                                                                                    : 99;
         if (rank < bestRank)
         {
@@ -431,6 +431,25 @@ MeshGeneratorOptions::FromParameters(const ParameterSet & parameters)
       throw Error("parameter morea_mesh_structure_shares: share of " + name + " is negative");
     options.shares[name] = share;
   }
+  options.shellOffsets.clear();
+  for (const std::string & item : ParseNameList(parameters.GetString("morea_mesh_shell_offsets")))
+  {
+    std::size_t used = 0;
+    double      offset = 0.0;
+    try
+    {
+      offset = std::stod(item, &used);
+    }
+    catch (const std::exception &)
+    {
+      used = 0;
+    }
+    if (used != item.size() || !(offset > 0.0) || !std::isfinite(offset))
+      throw Error("parameter morea_mesh_shell_offsets: \"" + item + "\" is not a positive distance in mm");
+    options.shellOffsets.push_back(offset);
+  }
+  options.shellFraction = parameters.GetReal("morea_mesh_shell_fraction");
+  options.shellStructures = ParseNameList(parameters.GetString("morea_mesh_surface_structures"));
 
   // Method names follow the paper: annotation-group[-random][-bladder][-<percent random>].
   const std::string & method = parameters.GetString("morea_mesh_generation_method");
@@ -526,7 +545,11 @@ GenerateMesh(const MeshDomain & domain, const std::vector<MeshStructure> & struc
   const std::size_t randomTarget =
     options.useContourPoints ? static_cast<std::size_t>(std::lround(options.randomFraction * static_cast<double>(total)))
                              : total - 8;
-  const std::size_t structureBudget = total - 8 - std::min(randomTarget, total - 8);
+  const std::size_t shellTarget =
+    options.useContourPoints && !options.shellOffsets.empty()
+      ? static_cast<std::size_t>(std::lround(options.shellFraction * static_cast<double>(total)))
+      : 0;
+  const std::size_t structureBudget = total - 8 - std::min(randomTarget + shellTarget, total - 8);
   std::vector<std::size_t> quota = Apportion(structureBudget, weights);
   report.secondsPlacement += SecondsSince(start);
 
@@ -580,6 +603,50 @@ GenerateMesh(const MeshDomain & domain, const std::vector<MeshStructure> & struc
     set.Add(chosen, PointOrigin::Contour, static_cast<std::int32_t>(s), domain, pinTolerance);
     report.contourPoints += chosen.size();
     report.pointsPerStructure.emplace_back(structures[s].name, chosen.size());
+  }
+
+  // Shells around the deforming organs, spread out like contour points; what
+  // they cannot use (a shell outside the domain) goes to the random points.
+  if (shellTarget > 0)
+  {
+    std::vector<std::pair<std::size_t, std::vector<Vec3>>> shells; // structure, candidates
+    for (std::size_t s = 0; s < structures.size(); ++s)
+    {
+      if (std::find(options.shellStructures.begin(), options.shellStructures.end(), structures[s].name) ==
+          options.shellStructures.end())
+        continue;
+      if (structures[s].mask == nullptr)
+      {
+        report.notes.push_back("no mask for the shells around " + structures[s].name + "; none placed there");
+        continue;
+      }
+      const Volume<float> distance = DistanceToMask(*structures[s].mask);
+      for (const double offset : options.shellOffsets)
+      {
+        std::vector<Vec3> inside;
+        for (const Vec3 & p : ShellPoints(distance, offset))
+          if (InsideShrunk(p, domain, contourGap))
+            inside.push_back(p);
+        if (inside.empty())
+          report.notes.push_back("the shell " + std::to_string(std::lround(offset)) + " mm around " + structures[s].name +
+                                 " lies outside the domain");
+        else
+          shells.emplace_back(s, std::move(inside));
+      }
+    }
+    if (shells.empty())
+      report.notes.push_back("no shell around any structure (morea_mesh_surface_structures names none with a "
+                             "mask): those points are random");
+    const std::vector<std::size_t> shellQuota =
+      shells.empty() ? std::vector<std::size_t>{}
+                     : Apportion(std::min(shellTarget, total > set.points.size() ? total - set.points.size() : 0),
+                                 std::vector<double>(shells.size(), 1.0));
+    for (std::size_t i = 0; i < shells.size(); ++i)
+    {
+      const std::vector<Vec3> chosen = SpreadOutSubset(shells[i].second, shellQuota[i], set.points, minimumDistance);
+      set.Add(chosen, PointOrigin::Shell, -1, domain, pinTolerance);
+      report.shellPoints += chosen.size();
+    }
   }
 
   // Random points fill up to the requested count: some on the faces, the rest inside.

@@ -40,7 +40,8 @@ def test_suite_pairs_use_the_paper_configuration(name):
     for key in ("ea_num_generations", "ea_population_size", "ea_num_clusters", "ea_archive_size",
                 "ea_adaptive_steering_activated_at_num_generations", "morea_mesh_num_points",
                 "morea_sampling_rate", "morea_rigid_weight", "morea_image_metric",
-                "morea_guidance_metric", "morea_mesh_generation_method", "problem_guidance_selection"):
+                "morea_guidance_metric", "morea_mesh_generation_method", "problem_guidance_selection",
+                "morea_mesh_shell_offsets", "morea_mesh_shell_fraction"):
         assert p[key] == paper[key], key
     assert p["morea_rigid_strain_limit"] == 0.03
     assert p["preprocess_isotropic_spacing"] == 4.0 and p["preprocess_crop_margin"] == 80.0
