@@ -56,7 +56,7 @@ def test_reads_the_meshes_morea_writes(morea, tmp_path):
     assert points.shape == (summary["points"], 3)
     assert tetrahedra.shape == (summary["tetrahedra"], 4)
     assert np.all(cc.signed_volumes(points, tetrahedra) > 0)
-    assert set(np.unique(arrays["origin"])) <= set(range(7))
+    assert set(np.unique(arrays["origin"])) <= set(range(9))  # TetrahedralMesh.h's PointOrigin
     assert arrays["structure"].max() >= 0  # contour points of the structures
 
 

@@ -222,7 +222,8 @@ def test_morea_job_for_the_gpu(tmp_path, monkeypatch):
     assert morea_record.md5_check(raw, job["raw_md5"]) == ["fixed.nii.gz: differs from the study's"]
     # The GPU script runs the same `morea register` as the study's runner.
     script = (common.REPO_ROOT / "bench" / "run-study-morea.sh").read_text()
-    assert f"--select {morea_runner.SELECT} --checkpoint-every 0" in script
+    assert f"select={morea_runner.SELECT}\n" in script
+    assert '--select "$select" --checkpoint-every 0' in script
     args = morea_runner.register_arguments(["--problem", "raw"], "p.toml", 3, ["--set", "x=1"],
                                            Path("t.tfm"), Path("o"))
     assert args == ["register", "--problem", "raw", "--parameters", "p.toml", "--set", "seed=3",
