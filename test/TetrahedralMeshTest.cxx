@@ -220,7 +220,7 @@ TEST(MeshGenerator, ShellOptionsFromParameters)
   EXPECT_EQ(o.shellStructures, (std::vector<std::string>{ "bladder" }));
   p.SetFromString("morea_mesh_shell_offsets", "5,12.5, 30");
   p.SetFromString("morea_mesh_shell_fraction", "0.2");
-  p.SetFromString("morea_mesh_surface_structures", "stomach, bladder");
+  p.SetFromString("morea_mesh_shell_structures", "stomach, bladder");
   o = morea_core::MeshGeneratorOptions::FromParameters(p);
   EXPECT_EQ(o.shellOffsets, (std::vector<double>{ 5.0, 12.5, 30.0 }));
   EXPECT_DOUBLE_EQ(o.shellFraction, 0.2);

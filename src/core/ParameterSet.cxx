@@ -79,8 +79,10 @@ MakeSpecs()
     Text("morea_mesh_structure_shares", "", {},
          "share of contour points per structure, e.g. \"bladder=2, bones=1\" (unnamed structures: 1)"),
     Text("morea_mesh_shell_offsets", "8, 20", {},
-         "distances in mm outside the structures of morea_mesh_surface_structures at which shells of mesh "
+         "distances in mm outside each structure of morea_mesh_shell_structures at which shells of mesh "
          "points are placed (comma-separated, e.g. \"8, 20\"; empty: none)"),
+    Text("morea_mesh_shell_structures", "bladder", {},
+         "the deforming organs that get shells of mesh points around them (comma-separated)"),
     Real("morea_mesh_shell_fraction", 0.15, 0.0, 0.9, "fraction of the mesh points on the shells, when any"),
     Real("morea_mesh_boundary_fraction", 0.25, 0.0, 1.0,
          "fraction of the random mesh points placed on the domain's faces (they slide within them)"),

@@ -449,7 +449,7 @@ MeshGeneratorOptions::FromParameters(const ParameterSet & parameters)
     options.shellOffsets.push_back(offset);
   }
   options.shellFraction = parameters.GetReal("morea_mesh_shell_fraction");
-  options.shellStructures = ParseNameList(parameters.GetString("morea_mesh_surface_structures"));
+  options.shellStructures = ParseNameList(parameters.GetString("morea_mesh_shell_structures"));
 
   // Method names follow the paper: annotation-group[-random][-bladder][-<percent random>].
   const std::string & method = parameters.GetString("morea_mesh_generation_method");
@@ -635,7 +635,7 @@ GenerateMesh(const MeshDomain & domain, const std::vector<MeshStructure> & struc
       }
     }
     if (shells.empty())
-      report.notes.push_back("no shell around any structure (morea_mesh_surface_structures names none with a "
+      report.notes.push_back("no shell around any structure (morea_mesh_shell_structures names none with a "
                              "mask): those points are random");
     const std::vector<std::size_t> shellQuota =
       shells.empty() ? std::vector<std::size_t>{}
