@@ -79,6 +79,10 @@ case "${1:-}" in
 
   run)
     out=${2:?usage: $0 run OUTDIR}
+    label=${MOREA_STUDY_LABEL:+-$MOREA_STUDY_LABEL}
+    if [ -n "${MOREA_STUDY_SET:-}" ] && [ -z "$label" ]; then
+      echo "MOREA_STUDY_SET needs MOREA_STUDY_LABEL (an experiment's runs are kept apart)" >&2; exit 2
+    fi
     mkdir -p "$out"
     out=$(cd "$out" && pwd)
     t0=$(date +%s)
@@ -97,10 +101,6 @@ case "${1:-}" in
     results="$work/results"
     mkdir -p "$results" "$work/raw" "$work/reg"
     deadline=${MOREA_STUDY_DEADLINE_S:-540}
-    label=${MOREA_STUDY_LABEL:+-$MOREA_STUDY_LABEL}
-    if [ -n "${MOREA_STUDY_SET:-}" ] && [ -z "$label" ]; then
-      echo "MOREA_STUDY_SET needs MOREA_STUDY_LABEL (an experiment's runs are kept apart)" >&2; exit 2
-    fi
     select=best-guidance,knee
     [ "${MOREA_STUDY_FRONT:-0}" = 1 ] && select=best-guidance,knee,all
     pairs_sel=${MOREA_STUDY_PAIRS:-}

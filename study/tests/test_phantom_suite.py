@@ -270,3 +270,19 @@ def test_preprocessing_check_reads_mha_and_nifti(tmp_path):
     problems = morea_record.check(reg, problem)
     assert any(p.startswith("moving: voxels differ") for p in problems)
     assert "moving landmarks differ from the problem's" in problems
+
+
+def test_gpu_script_keeps_experiments_apart(tmp_path):
+    """MOREA_STUDY_SET (an experiment's overrides) without MOREA_STUDY_LABEL is
+    refused before anything runs, so an experiment never lands among the study's runs."""
+    import os
+    import subprocess
+    script = common.REPO_ROOT / "bench" / "run-study-morea.sh"
+    env = dict(os.environ, MOREA_BIN="/bin/true", MOREA_STUDY_WORK=str(tmp_path / "work"),
+               MOREA_STUDY_SET="morea_mesh_shell_offsets=8,20")
+    env.pop("MOREA_STUDY_LABEL", None)
+    done = subprocess.run(["bash", str(script), "run", str(tmp_path / "out")], env=env,
+                          capture_output=True, text=True)
+    assert done.returncode == 2
+    assert "MOREA_STUDY_LABEL" in done.stderr
+    assert not (tmp_path / "work").exists() and not (tmp_path / "out").exists()
