@@ -251,10 +251,7 @@ TEST(ConstraintSurfaces, SurfacesThatMeetAreLeftOutWithTheReason)
 TEST(Tetrahedralization, ChildProcessOverhead)
 {
   const auto &                      pm = morea_test::PhantomMesh600();
-  std::vector<morea_core::MeshStructure> structures;
-  for (std::size_t s = 1; s < pm.names.size(); ++s)
-    structures.push_back({ pm.names[s], morea_core::MaskBoundaryPoints(pm.phantomCase.movingMasks[s]),
-                           &pm.phantomCase.movingMasks[s] });
+  const auto & structures = pm.structures;
   morea_core::MeshGeneratorOptions options;
   options.seed = 7;
   double                      seconds[2] = { 0.0, 0.0 };

@@ -20,6 +20,8 @@ struct PhantomMesh
   morea_core::TetrahedralMesh        mesh;
   morea_core::MeshGenerationReport   report;
   std::vector<std::string>      names;
+  /** The mesh's structures (all but the body), pointing at phantomCase's masks. */
+  std::vector<morea_core::MeshStructure> structures;
 };
 
 /** The phantom at 3 mm; the domain is the bladder's bounding box on the moving
@@ -48,15 +50,14 @@ PhantomMesh600()
       pm->domain.lower[a] = std::max(full.lower[a], lo[a] - 30.0);
       pm->domain.upper[a] = std::min(full.upper[a], hi[a] + 30.0);
     }
-    std::vector<morea_core::MeshStructure> structures;
     for (std::size_t s = 1; s < pm->names.size(); ++s) // all but the body
     {
-      structures.push_back({ pm->names[s], morea_core::MaskBoundaryPoints(pm->phantomCase.movingMasks[s]),
-                             &pm->phantomCase.movingMasks[s] });
+      pm->structures.push_back({ pm->names[s], morea_core::MaskBoundaryPoints(pm->phantomCase.movingMasks[s]),
+                                 &pm->phantomCase.movingMasks[s] });
     }
     morea_core::MeshGeneratorOptions options; // 600 points, bladder surface
     options.seed = 7;
-    pm->mesh = morea_core::GenerateMesh(pm->domain, structures, options, &pm->report);
+    pm->mesh = morea_core::GenerateMesh(pm->domain, pm->structures, options, &pm->report);
     return pm;
   }();
   return *cached;

@@ -237,10 +237,7 @@ TEST(MeshGenerator, ShellOptionsFromParameters)
 TEST(MeshGenerator, ShellsAroundTheBladder)
 {
   const auto &                           pm = morea_test::PhantomMesh600();
-  std::vector<morea_core::MeshStructure> structures;
-  for (std::size_t s = 1; s < pm.names.size(); ++s)
-    structures.push_back({ pm.names[s], morea_core::MaskBoundaryPoints(pm.phantomCase.movingMasks[s]),
-                           &pm.phantomCase.movingMasks[s] });
+  const auto & structures = pm.structures;
   morea_core::MeshGeneratorOptions options;
   options.seed = 7;
   options.shellOffsets = { 6.0, 15.0 };
@@ -257,7 +254,6 @@ TEST(MeshGenerator, ShellsAroundTheBladder)
   // Shell points sit at one of the offsets from the bladder, not on any structure.
   const auto & bladder = pm.phantomCase.movingMasks[2];
   ASSERT_EQ(pm.names[2], "bladder");
-  const auto   distance = morea_core::DistanceToMask(bladder);
   const double half = 0.5 * bladder.spacing[0];
   std::size_t  shell = 0, onShell = 0;
   for (std::size_t i = 0; i < mesh.origins.size(); ++i)
@@ -360,10 +356,7 @@ TEST(MeshGenerator, PhantomMeshWithBladderSurface)
 TEST(MeshGenerator, SameSeedSameMesh)
 {
   const auto &                      pm = morea_test::PhantomMesh600();
-  std::vector<morea_core::MeshStructure> structures;
-  for (std::size_t s = 1; s < pm.names.size(); ++s)
-    structures.push_back({ pm.names[s], morea_core::MaskBoundaryPoints(pm.phantomCase.movingMasks[s]),
-                           &pm.phantomCase.movingMasks[s] });
+  const auto & structures = pm.structures;
   morea_core::MeshGeneratorOptions options;
   options.seed = 7;
   const auto again = morea_core::GenerateMesh(pm.domain, structures, options);
