@@ -218,10 +218,11 @@ RemoveSlivers(PointSet & set, TetrahedralizationResult & tet,
         if (i >= set.points.size() || moved[i])
           continue;
         const PointOrigin o = set.origins[i];
-        const int rank = (o == PointOrigin::Random || o == PointOrigin::Refinement || o == PointOrigin::Shell) ? 0
-                         : o == PointOrigin::BoundaryFace                                                 ? 1
-                         : o == PointOrigin::Contour                                                      ? 2
-                                                                                   : 99;
+        const bool free = o == PointOrigin::Random || o == PointOrigin::Refinement || o == PointOrigin::Shell;
+        const int  rank = free                             ? 0
+                          : o == PointOrigin::BoundaryFace ? 1
+                          : o == PointOrigin::Contour      ? 2
+                                                           : 99;
         if (rank < bestRank)
         {
           bestRank = rank;
@@ -609,7 +610,7 @@ GenerateMesh(const MeshDomain & domain, const std::vector<MeshStructure> & struc
   // they cannot use (a shell outside the domain) goes to the random points.
   if (shellTarget > 0)
   {
-    std::vector<std::pair<std::size_t, std::vector<Vec3>>> shells; // structure, candidates
+    std::vector<std::vector<Vec3>> shells; // candidates per structure and offset
     for (std::size_t s = 0; s < structures.size(); ++s)
     {
       if (std::find(options.shellStructures.begin(), options.shellStructures.end(), structures[s].name) ==
@@ -631,19 +632,18 @@ GenerateMesh(const MeshDomain & domain, const std::vector<MeshStructure> & struc
           report.notes.push_back("the shell " + std::to_string(std::lround(offset)) + " mm around " + structures[s].name +
                                  " lies outside the domain");
         else
-          shells.emplace_back(s, std::move(inside));
+          shells.push_back(std::move(inside));
       }
     }
     if (shells.empty())
       report.notes.push_back("no shell around any structure (morea_mesh_shell_structures names none with a "
                              "mask): those points are random");
     const std::vector<std::size_t> shellQuota =
-      shells.empty() ? std::vector<std::size_t>{}
-                     : Apportion(std::min(shellTarget, total > set.points.size() ? total - set.points.size() : 0),
-                                 std::vector<double>(shells.size(), 1.0));
+      Apportion(std::min(shellTarget, total > set.points.size() ? total - set.points.size() : 0),
+                std::vector<double>(shells.size(), 1.0));
     for (std::size_t i = 0; i < shells.size(); ++i)
     {
-      const std::vector<Vec3> chosen = SpreadOutSubset(shells[i].second, shellQuota[i], set.points, minimumDistance);
+      const std::vector<Vec3> chosen = SpreadOutSubset(shells[i], shellQuota[i], set.points, minimumDistance);
       set.Add(chosen, PointOrigin::Shell, -1, domain, pinTolerance);
       report.shellPoints += chosen.size();
     }
