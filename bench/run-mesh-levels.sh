@@ -9,19 +9,26 @@
 #   Here:        bench/run-mesh-levels.sh bundle
 #   On the GPU:  bench/run-mesh-levels.sh run OUTDIR [CONFIGS]
 # CONFIGS: words PROBLEM:SCHEDULE, PROBLEM abdomen or phantom, SCHEDULE
-# below (default: both problems with 1 and 3).
+# below (default: both problems with 1 and 3). MOREA_LEVELS_SET: more
+# KEY=VALUE overrides for every run (abdomen only), e.g. morea_repair_method=none.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 DATA=${MOREA_DATA:-../shared/data/abdomen-cbct-pair}
 # Mesh level schedules by name: 1 (one mesh), 3 (600 points for 200
 # generations, ~1400 for 200, ~3200 for 100), 2a (600 for 400, ~1400 for
-# 100), 2b (600 for 450, ~3200 for 50).
+# 100), 2b (600 for 450, ~3200 for 50); a trailing g (3g, 2g, 2bg) makes the
+# refined levels' FOS elements groups of points (morea_fos_type =
+# coarse-groups); 2g: 600 for 250, ~3200 for 250.
 schedule() {
+  case "$1" in
+    *g) echo "$(schedule "${1%g}") morea_fos_type=coarse-groups"; return ;;
+  esac
   case "$1" in
     1) ;;
     3) echo morea_max_num_mesh_levels=3 morea_num_generations_per_level=200 morea_mesh_refinement_factor=2.3 ;;
     2a) echo morea_max_num_mesh_levels=2 morea_num_generations_per_level=400 morea_mesh_refinement_factor=2.3 ;;
     2b) echo morea_max_num_mesh_levels=2 morea_num_generations_per_level=450 morea_mesh_refinement_factor=5.3 ;;
+    2) echo morea_max_num_mesh_levels=2 morea_num_generations_per_level=250 morea_mesh_refinement_factor=5.3 ;;
     *) echo "unknown schedule $1" >&2; exit 2 ;;
   esac
 }
@@ -58,10 +65,11 @@ case "${1:-}" in
       case "$problem" in
         abdomen)
           sets=()
-          for o in $(schedule "$levels"); do sets+=(--set "$o"); done
+          for o in $(schedule "$levels") ${MOREA_LEVELS_SET:-}; do sets+=(--set "$o"); done
           start=$(date +%s.%N)
           "$B/morea" register --problem "$D/abdomen" --parameters "$D/abdomen_paper.toml" "${sets[@]}" -o "/tmp/runs/$config" \
             --select best-guidance,knee >"$out/abdomen-$levels.log" 2>&1 || echo "failed: abdomen-$levels"
+          grep -E "^generation (450|451|452|460|500)/" "$out/abdomen-$levels.log" || true
           echo "abdomen levels $levels: $(awk -v a="$start" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f", b - a }') s"
           grep -E "^(mesh|best_guidance|knee|  [A-Z])" "$out/abdomen-$levels.log" || true
           ;;

@@ -8,6 +8,7 @@
 #include "itkPreprocessing.h"
 #include "morea_core/Error.h"
 #include "morea_core/FoldConstraint.h"
+#include "morea_core/ParallelStructure.h"
 #include "morea_core/ParameterSet.h"
 
 #include <gtest/gtest.h>
@@ -173,5 +174,42 @@ TEST(CheckpointResume, MultiLevelRunsRefineCarryOverAndResumeAcrossLevels)
     EXPECT_EQ(resumed.front[i].fitness.objectives, whole.front[i].fitness.objectives);
     EXPECT_EQ(resumed.front[i].mesh.target, whole.front[i].mesh.target);
   }
+}
+
+TEST(CheckpointResume, GroupedFosElementsOnTheRefinedLevel)
+{
+  SmallRun              run;
+  morea_core::ParameterSet p = run.parameters;
+  p.SetFromString("ea_num_generations", "3");
+  p.SetFromString("morea_max_num_mesh_levels", "2");
+  p.SetFromString("morea_num_generations_per_level", "2");
+  p.SetFromString("morea_mesh_refinement_factor", "3");
+  p.SetFromString("morea_fos_type", "coarse-groups");
+  MeshRegistrationOptions options;
+  options.backend = morea_core::BackendChoice::Cpu;
+  options.threads = 2;
+  const MeshRegistrationResult result = RegisterMeshes(run.problem, p, options);
+  const auto &                 model = result.model;
+  // Groups (about the first level's element count): far fewer than the refined
+  // mesh's edges; every point in one of them.
+  const morea_core::ParallelStructure edges = morea_core::BuildParallelStructure(
+    morea_core::MeshTopology(result.model.base.tetrahedra, result.model.base.NumberOfPoints()));
+  EXPECT_LT(model.parallel.elements.size(), edges.elements.size() / 2);
+  std::vector<int> coveredBy(model.base.NumberOfPoints(), 0);
+  for (const auto & e : model.parallel.elements)
+  {
+    EXPECT_GE(e.points.size(), 2u);
+    for (auto q : e.points)
+      ++coveredBy[q];
+  }
+  EXPECT_EQ(std::count(coveredBy.begin(), coveredBy.end(), 1), static_cast<std::ptrdiff_t>(coveredBy.size()));
+  EXPECT_NE(std::find_if(model.report.notes.begin(), model.report.notes.end(),
+                         [](const std::string & n) { return n.find("coarse-groups") != std::string::npos; }),
+            model.report.notes.end());
+  ASSERT_EQ(result.history.size(), 4u);
+  const morea_core::FoldConstraint constraint(model.topology, model.base.points);
+  ASSERT_FALSE(result.front.empty());
+  for (const auto & s : result.front)
+    EXPECT_TRUE(constraint.Evaluate(s.mesh).Feasible());
 }
 } // namespace

@@ -1,8 +1,10 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
-// Tests of the linkage model: edge set cover, interaction graph, DSATUR groups.
+// Tests of the linkage model: edge set cover, point groups, interaction graph,
+// DSATUR groups.
 #include "MeshTestSupport.h"
 
+#include "morea_core/Error.h"
 #include "morea_core/ParallelStructure.h"
 
 #include <gtest/gtest.h>
@@ -121,5 +123,79 @@ TEST(ParallelStructure, PhantomMeshCoverAndGroups)
   ExpectProperColouring(structure.interactions, structure.colour);
   std::cout << "phantom mesh: " << structure.elements.size() << " FOS elements, " << structure.groups.size()
             << " parallel groups (colours)\n";
+}
+
+/** Whether `members` are connected through mesh edges among themselves. */
+bool
+Connected(const morea_core::MeshTopology & topology, const std::vector<std::uint32_t> & members)
+{
+  const std::set<std::uint32_t> inside(members.begin(), members.end());
+  std::set<std::uint32_t>       reached{ members.front() };
+  std::vector<std::uint32_t>    stack{ members.front() };
+  while (!stack.empty())
+  {
+    const std::uint32_t p = stack.back();
+    stack.pop_back();
+    for (std::uint32_t q : topology.Neighbours(p))
+      if (inside.count(q) && reached.insert(q).second)
+        stack.push_back(q);
+  }
+  return reached.size() == inside.size();
+}
+
+TEST(ParallelStructure, PointGroupsCoverOnceConnectedAndSized)
+{
+  const auto &                   pm = morea_test::PhantomMesh600();
+  const morea_core::MeshTopology topology(pm.mesh.tetrahedra, pm.mesh.NumberOfPoints());
+  const std::size_t              n = topology.NumberOfPoints();
+  for (const std::size_t size : { 1u, 2u, 5u, 10u })
+  {
+    const auto groups = morea_core::GreedyPointGroups(topology, pm.mesh.points, size);
+    std::vector<int> coveredBy(n, 0);
+    std::size_t      largest = 0;
+    for (const auto & g : groups)
+    {
+      ASSERT_FALSE(g.empty());
+      EXPECT_TRUE(std::is_sorted(g.begin(), g.end()));
+      EXPECT_TRUE(Connected(topology, g)) << "a group of " << g.size() << " points is not connected";
+      EXPECT_GE(g.size(), (size + 1) / 2) << "a group below half the size was not merged";
+      largest = std::max(largest, g.size());
+      for (auto p : g)
+        ++coveredBy[p];
+    }
+    for (std::size_t p = 0; p < n; ++p)
+      EXPECT_EQ(coveredBy[p], 1) << "point " << p << " with group size " << size;
+    // A merged group holds at most a full group and a few small ones.
+    EXPECT_LE(largest, 3 * size) << "group size " << size;
+    // About n / size groups: few are cut short by their corner.
+    EXPECT_GE(groups.size(), n / size / 2) << "group size " << size;
+    EXPECT_LE(groups.size(), n / size + n / size / 2 + 1) << "group size " << size;
+    if (size == 1)
+      EXPECT_EQ(groups.size(), n);
+  }
+  EXPECT_THROW(morea_core::GreedyPointGroups(topology, pm.mesh.points, 0), morea_core::Error);
+  EXPECT_THROW(morea_core::GreedyPointGroups(topology, { pm.mesh.points.begin(), pm.mesh.points.end() - 1 }, 4),
+               morea_core::Error);
+}
+
+TEST(ParallelStructure, GroupedStructureHasTheGroupsAsElements)
+{
+  const auto &                   pm = morea_test::PhantomMesh600();
+  const morea_core::MeshTopology topology(pm.mesh.tetrahedra, pm.mesh.NumberOfPoints());
+  const auto                     groups = morea_core::GreedyPointGroups(topology, pm.mesh.points, 8);
+  const auto                     structure = morea_core::BuildParallelStructure(topology, groups);
+  ASSERT_EQ(structure.elements.size(), groups.size());
+  for (std::size_t e = 0; e < groups.size(); ++e)
+  {
+    EXPECT_EQ(structure.elements[e].points, groups[e]);
+    EXPECT_EQ(structure.elements[e].dependentTetrahedra, morea_core::DependentTetrahedra(topology, groups[e]));
+  }
+  ExpectProperColouring(structure.interactions, structure.colour);
+  // Fewer, larger elements than the edge cover, in more colours.
+  const auto edges = morea_core::BuildParallelStructure(topology);
+  EXPECT_LT(structure.elements.size(), edges.elements.size() / 3);
+  std::cout << "phantom mesh, groups of 8: " << structure.elements.size() << " FOS elements, "
+            << structure.groups.size() << " parallel groups (colours)\n";
+  EXPECT_THROW(morea_core::BuildParallelStructure(topology, { {} }), morea_core::Error);
 }
 } // namespace

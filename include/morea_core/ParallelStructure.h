@@ -1,8 +1,9 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
 // MultiObjectiveRegistration core: the linkage model of the mesh (SPEC 4.4).
-// FOS elements are edges chosen by a greedy set cover of the points; elements
-// whose dependent tetrahedra overlap interact; DSATUR colours the interaction
+// FOS elements are edges chosen by a greedy set cover of the points (or, on
+// refined mesh levels, connected groups of points); elements whose dependent
+// tetrahedra overlap interact; DSATUR colours the interaction
 // graph into parallel groups whose elements can be varied and evaluated at
 // the same time without touching each other's tetrahedra.
 #ifndef morea_ParallelStructure_h
@@ -35,6 +36,14 @@ struct ParallelStructure
 std::vector<Edge>
 GreedyEdgeCover(const MeshTopology & topology);
 
+/** Connected groups of about `size` points that cover every point once.
+ *  A group starts at the free point with the fewest free neighbours and
+ *  takes the free neighbour nearest its first point until it is full; a
+ *  group left with fewer than half that joins its smallest neighbouring
+ *  group. `size` 1 gives one group per point. */
+std::vector<std::vector<std::uint32_t>>
+GreedyPointGroups(const MeshTopology & topology, const std::vector<Vec3> & points, std::size_t size);
+
 /** Tetrahedra that have any of `points` as a vertex, ascending. */
 std::vector<std::uint32_t>
 DependentTetrahedra(const MeshTopology & topology, const std::vector<std::uint32_t> & points);
@@ -47,9 +56,13 @@ InteractionGraph(const std::vector<FosElement> & elements, std::size_t numberOfT
 std::vector<std::uint32_t>
 DsaturColouring(const std::vector<std::vector<std::uint32_t>> & graph);
 
-/** All of the above for one mesh. */
+/** All of the above for one mesh, with the edge cover's elements. */
 ParallelStructure
 BuildParallelStructure(const MeshTopology & topology);
+
+/** All of the above with the given elements (their points). */
+ParallelStructure
+BuildParallelStructure(const MeshTopology & topology, const std::vector<std::vector<std::uint32_t>> & elementPoints);
 } // namespace morea_core
 
 #endif

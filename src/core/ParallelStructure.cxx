@@ -78,6 +78,106 @@ GreedyEdgeCover(const MeshTopology & topology)
   return edges;
 }
 
+std::vector<std::vector<std::uint32_t>>
+GreedyPointGroups(const MeshTopology & topology, const std::vector<Vec3> & points, std::size_t size)
+{
+  const std::size_t n = topology.NumberOfPoints();
+  if (points.size() != n)
+    throw Error("point groups: " + std::to_string(points.size()) + " coordinates for a mesh of " + std::to_string(n) +
+                " points");
+  if (size == 0)
+    throw Error("point groups: a group size of 0");
+  constexpr std::uint32_t free = UINT32_MAX;
+  std::vector<std::uint32_t> group(n, free);
+  // Free neighbours per point, smallest first, as in GreedyEdgeCover: points
+  // in corners are grouped before their options run out.
+  std::vector<std::size_t>                        freeNeighbours(n);
+  std::set<std::pair<std::size_t, std::uint32_t>> queue;
+  for (std::size_t p = 0; p < n; ++p)
+  {
+    freeNeighbours[p] = topology.Neighbours(p).size();
+    queue.insert({ freeNeighbours[p], static_cast<std::uint32_t>(p) });
+  }
+  std::vector<std::vector<std::uint32_t>> groups;
+  const auto take = [&](std::uint32_t p) {
+    group[p] = static_cast<std::uint32_t>(groups.size() - 1);
+    groups.back().push_back(p);
+    queue.erase({ freeNeighbours[p], p });
+    for (std::uint32_t q : topology.Neighbours(p))
+      if (group[q] == free)
+      {
+        queue.erase({ freeNeighbours[q], q });
+        --freeNeighbours[q];
+        queue.insert({ freeNeighbours[q], q });
+      }
+  };
+  const auto squaredDistance = [&](std::uint32_t a, std::uint32_t b) {
+    double d = 0.0;
+    for (int i = 0; i < 3; ++i)
+      d += (points[a][i] - points[b][i]) * (points[a][i] - points[b][i]);
+    return d;
+  };
+  while (!queue.empty())
+  {
+    const std::uint32_t first = queue.begin()->second;
+    groups.emplace_back();
+    take(first);
+    // The group's free neighbours, nearest to its first point first.
+    std::set<std::pair<double, std::uint32_t>> frontier;
+    const auto widen = [&](std::uint32_t p) {
+      for (std::uint32_t q : topology.Neighbours(p))
+        if (group[q] == free)
+          frontier.insert({ squaredDistance(first, q), q });
+    };
+    widen(first);
+    while (groups.back().size() < size && !frontier.empty())
+    {
+      const std::uint32_t q = frontier.begin()->second;
+      frontier.erase(frontier.begin());
+      if (group[q] != free)
+        continue;
+      take(q);
+      widen(q);
+    }
+  }
+  // Small groups join their smallest neighbouring group (the mesh is
+  // connected through shared tetrahedra, so a small group has neighbours
+  // unless it is the whole mesh).
+  const std::size_t smallest = (size + 1) / 2;
+  std::vector<bool> merged(groups.size(), false);
+  for (std::size_t g = 0; g < groups.size(); ++g)
+  {
+    if (groups[g].size() >= smallest)
+      continue;
+    std::size_t target = groups.size();
+    for (std::uint32_t p : groups[g])
+      for (std::uint32_t q : topology.Neighbours(p))
+      {
+        const std::uint32_t h = group[q];
+        if (h != g && (target == groups.size() || groups[h].size() < groups[target].size() ||
+                       (groups[h].size() == groups[target].size() && h < target)))
+          target = h;
+      }
+    if (target == groups.size())
+      continue;
+    for (std::uint32_t p : groups[g])
+    {
+      group[p] = static_cast<std::uint32_t>(target);
+      groups[target].push_back(p);
+    }
+    groups[g].clear();
+    merged[g] = true;
+  }
+  std::vector<std::vector<std::uint32_t>> result;
+  for (std::size_t g = 0; g < groups.size(); ++g)
+    if (!merged[g])
+    {
+      std::sort(groups[g].begin(), groups[g].end());
+      result.push_back(std::move(groups[g]));
+    }
+  return result;
+}
+
 std::vector<std::uint32_t>
 DependentTetrahedra(const MeshTopology & topology, const std::vector<std::uint32_t> & points)
 {
@@ -160,11 +260,22 @@ DsaturColouring(const std::vector<std::vector<std::uint32_t>> & graph)
 ParallelStructure
 BuildParallelStructure(const MeshTopology & topology)
 {
-  ParallelStructure structure;
+  std::vector<std::vector<std::uint32_t>> elementPoints;
   for (const Edge & e : GreedyEdgeCover(topology))
+    elementPoints.push_back({ e[0], e[1] });
+  return BuildParallelStructure(topology, elementPoints);
+}
+
+ParallelStructure
+BuildParallelStructure(const MeshTopology & topology, const std::vector<std::vector<std::uint32_t>> & elementPoints)
+{
+  ParallelStructure structure;
+  for (const auto & points : elementPoints)
   {
+    if (points.empty())
+      throw Error("a FOS element without points");
     FosElement element;
-    element.points = { e[0], e[1] };
+    element.points = points;
     element.dependentTetrahedra = DependentTetrahedra(topology, element.points);
     structure.elements.push_back(std::move(element));
   }

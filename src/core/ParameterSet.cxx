@@ -109,7 +109,10 @@ MakeSpecs()
     Text("morea_image_metric", "squared-differences", { "squared-differences" }, "intensity objective"),
     Text("morea_guidance_metric", "continuous-per-group", { "continuous-per-group" }, "guidance objective"),
     Real("morea_sampling_rate", 1.0, 1e-6, 1000.0, "intensity samples per voxel volume"),
-    Text("morea_fos_type", "edges", { "edges" }, "linkage model (FOS elements)"),
+    Text("morea_fos_type", "edges", { "edges", "coarse-groups" },
+         "linkage model (FOS elements): \"edges\" (pairs of neighbouring points) on every mesh level, or "
+         "\"coarse-groups\" (edges on the first level; on refined levels connected groups of points, as many as "
+         "the level before had elements: fewer candidates, but more of them fold; see bench/results/mesh-levels.md)"),
     Text("morea_symmetry_mode", "transform-both", { "transform-both" }, "objectives in both directions"),
     Text("morea_dual_dynamic_mode", "dual", { "dual" }, "both meshes' points are variables"),
     Text("morea_repair_method", "gaussian", { "gaussian", "none" }, "repair of folded solutions"),

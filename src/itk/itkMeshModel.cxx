@@ -61,13 +61,26 @@ RigidStructureNames(const RegistrationProblem & problem, const morea_core::Param
   return names;
 }
 /** What follows from the base mesh: topology, parallel structure,
- *  elasticity factors and the rigidity model. */
+ *  elasticity factors and the rigidity model. `fosElements` > 0: the FOS
+ *  elements are about that many groups of points (morea_fos_type
+ *  coarse-groups on a refined level), else edges. */
 void
-DeriveMeshModelParts(const RegistrationProblem & problem, const morea_core::ParameterSet & parameters, MeshModel & model)
+DeriveMeshModelParts(const RegistrationProblem & problem, const morea_core::ParameterSet & parameters, MeshModel & model,
+                     std::size_t fosElements = 0)
 {
   auto start = Clock::now();
   model.topology = morea_core::MeshTopology(model.base.tetrahedra, model.base.NumberOfPoints());
-  model.parallel = morea_core::BuildParallelStructure(model.topology);
+  if (fosElements == 0)
+    model.parallel = morea_core::BuildParallelStructure(model.topology);
+  else
+  {
+    const std::size_t points = model.base.NumberOfPoints();
+    const std::size_t size = std::max<std::size_t>(2, (points + fosElements - 1) / fosElements);
+    model.parallel = morea_core::BuildParallelStructure(
+      model.topology, morea_core::GreedyPointGroups(model.topology, model.base.points, size));
+    model.report.notes.push_back("FOS elements: " + std::to_string(model.parallel.elements.size()) +
+                                 " groups of about " + std::to_string(size) + " points (morea_fos_type = coarse-groups)");
+  }
   model.report.fosElements = model.parallel.elements.size();
   model.report.parallelGroups = model.parallel.groups.size();
   model.report.secondsParallelStructure = SecondsSince(start);
@@ -224,7 +237,8 @@ RefineMeshModel(const MeshModel & coarse, const RegistrationProblem & problem, c
     }
     model.report.notes.push_back("mesh refined from " + std::to_string(coarse.base.NumberOfPoints()) + " to " +
                                  std::to_string(model.base.NumberOfPoints()) + " points");
-    DeriveMeshModelParts(problem, parameters, model);
+    const bool grouped = parameters.GetString("morea_fos_type") == "coarse-groups";
+    DeriveMeshModelParts(problem, parameters, model, grouped ? coarse.parallel.elements.size() : 0);
   }
   catch (const morea_core::Error & e)
   {
