@@ -350,8 +350,9 @@ def write_all(study, rows: list[dict], chosen: dict) -> None:
                                    "yes" if c["passed"] else "NO"] for c in checks]))
         md.append("")
     if conv:
-        md.append(f"## Convergence check (best configuration, seed 1, twice the iterations; "
-                  f"converged: |change| of {pair.criteria[0].label} < 1 %)")
+        md.append(f"## Convergence check (best configuration, seed 1, twice the iterations, "
+                  f"doubled again while not converged; converged: |change| of "
+                  f"{pair.criteria[0].label} < 1 %)")
         md.append(markdown_table(
             ["method", "config", "iterations", "used", "score", "iterations x2", "used x2",
              "score x2", "relative change", "converged", "time s", "time x2 s"],

@@ -23,7 +23,8 @@ Steps (each run is skipped when its scores.json exists, so a killed study resume
     landmarks, the truth being known).
  4. Convergence check (profile "paper"): the best configuration with seed 1
     again at twice the iterations; the budget counts as converged when the
-    pair's first criterion changes by less than 1 % (report: convergence.csv).
+    pair's first criterion changes by less than 1 %; a budget that is not is
+    doubled again, up to 4x (report: convergence.csv, one row per doubling).
  5. Repeats: the best configurations and MOREA (each of the pair's MOREA
     configurations) with seeds 1..--seeds.
  6. results.csv (every run), tables (CSV, Markdown), two-sided Mann-Whitney U
@@ -80,6 +81,9 @@ PAPER = {
                 "parameter_estimation": "DisplacementDistribution"},
     "ants": {"weights": WEIGHTS, "iterations": (2000, 1000, 500, 250), "cc_radius_mm": 12.0},
     "convergence_check": True,
+    # A budget that is not converged is doubled again (200 -> 400 -> 800 for
+    # elastix), up to this multiple of the profile's iterations.
+    "convergence_max_scale": 4,
 }
 PROFILES = {"reduced": REDUCED, "paper": PAPER, "quick": QUICK}
 ALPHA = 0.025
@@ -290,8 +294,16 @@ class Study:
         if self.settings.get("convergence_check") and not self.args.no_convergence_check:
             for m in competitors:
                 best = self.best_weight(m)
-                if best is not None:
-                    self.run_one(m, best, 1, scale=2)
+                if best is None:
+                    continue
+                # Double until the score changes by < 1 % or the largest scale ran.
+                scale = 2
+                self.run_one(m, best, 1, scale=scale)
+                while (scale < self.settings.get("convergence_max_scale", 2)
+                       and self.convergence_step(m, best, scale // 2) is not None
+                       and not self.convergence_step(m, best, scale // 2)["converged"]):
+                    scale *= 2
+                    self.run_one(m, best, 1, scale=scale)
         for m in competitors:
             best = self.best_weight(m)
             if best is None:
@@ -317,10 +329,36 @@ class Study:
                 best, best_val = w, v
         return best
 
-    def convergence(self) -> list[dict]:
-        """Per competitor: the best configuration's seed-1 run and its run at
-        twice the iterations, the relative change of the pair's first criterion."""
+    def convergence_step(self, method: str, weight, scale: int) -> dict | None:
+        """The best configuration's seed-1 run at `scale` times the iterations
+        against its run at twice that: the relative change of the pair's first
+        criterion; None when either run has no scores."""
         crit = self.pair.criteria[0]
+        a, b = self.run_dir(method, weight, 1, scale), self.run_dir(method, weight, 1, 2 * scale)
+        if not (a / "scores.json").exists() or not (b / "scores.json").exists():
+            return None
+        va = evaluation.flatten(common.read_json(a / "scores.json")).get(crit.column)
+        vb = evaluation.flatten(common.read_json(b / "scores.json")).get(crit.column)
+        ra = common.read_json(a / "run.json") if (a / "run.json").exists() else {}
+        rb = common.read_json(b / "run.json") if (b / "run.json").exists() else {}
+        change = relative_change(va, vb)
+        return {
+            "method": method, "config": config_name(method, weight, scale), "score": crit.column,
+            "iterations": ra.get("iterations", ra.get("iterations_per_resolution")),
+            "iterations_used": ra.get("iterations_used"),
+            "score_at_budget": va,
+            "iterations_doubled": rb.get("iterations", rb.get("iterations_per_resolution")),
+            "iterations_used_doubled": rb.get("iterations_used"),
+            "score_doubled": vb, "relative_change": change,
+            "converged": change is not None and change < CONVERGED_BELOW,
+            "seconds": (ra.get("seconds") or {}).get("registration"),
+            "seconds_doubled": (rb.get("seconds") or {}).get("registration"),
+        }
+
+    def convergence(self) -> list[dict]:
+        """Per competitor: the best configuration's seed-1 run against its run at
+        twice the iterations, and each further doubling that ran (x2 -> x4, ...):
+        one row per step, the relative change of the pair's first criterion."""
         out = []
         for m in ("elastix", "ants"):
             if m not in self.settings:
@@ -328,26 +366,10 @@ class Study:
             w = self.best_weight(m)
             if w is None:
                 continue
-            a, b = self.run_dir(m, w, 1), self.run_dir(m, w, 1, scale=2)
-            if not (a / "scores.json").exists() or not (b / "scores.json").exists():
-                continue
-            va = evaluation.flatten(common.read_json(a / "scores.json")).get(crit.column)
-            vb = evaluation.flatten(common.read_json(b / "scores.json")).get(crit.column)
-            ra = common.read_json(a / "run.json") if (a / "run.json").exists() else {}
-            rb = common.read_json(b / "run.json") if (b / "run.json").exists() else {}
-            change = relative_change(va, vb)
-            out.append({
-                "method": m, "config": config_name(m, w), "score": crit.column,
-                "iterations": ra.get("iterations", ra.get("iterations_per_resolution")),
-                "iterations_used": ra.get("iterations_used"),
-                "score_at_budget": va,
-                "iterations_doubled": rb.get("iterations", rb.get("iterations_per_resolution")),
-                "iterations_used_doubled": rb.get("iterations_used"),
-                "score_doubled": vb, "relative_change": change,
-                "converged": change is not None and change < CONVERGED_BELOW,
-                "seconds": (ra.get("seconds") or {}).get("registration"),
-                "seconds_doubled": (rb.get("seconds") or {}).get("registration"),
-            })
+            scale = 1
+            while (step := self.convergence_step(m, w, scale)) is not None:
+                out.append(step)
+                scale *= 2
         return out
 
     # -- rescore ---------------------------------------------------------------

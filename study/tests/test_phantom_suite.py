@@ -177,6 +177,26 @@ def test_convergence_check_and_acceptance(tmp_path, monkeypatch):
     assert conv["elastix"]["iterations"] == 200 and conv["elastix"]["iterations_doubled"] == 400
     # The doubled runs are no candidates for the best configuration.
     assert study.best_weight("elastix") == 1.0
+    # Not converged: doubled again (800 iterations); one row per doubling.
+    ran = []
+    monkeypatch.setattr(study, "run_one", lambda m, w, seed, scale=1, variant="default":
+                        ran.append((m, w, seed, scale)))
+    study.settings["elastix"]["weights"] = [0.0, 1.0]
+    study.settings["ants"]["weights"] = [0.0, 1.0, 10.0]
+    study.settings["seeds"] = 0
+    study.sweep_and_repeat()
+    assert ("elastix", 1.0, 1, 4) in ran and ("ants", 0.0, 1, 4) not in ran
+    _run(out, "elastix", "w1-x4", 1, _scores(2.939),
+         {"iterations_per_resolution": 800, "seconds": {"registration": 400.0}})
+    steps = [c for c in study.convergence() if c["method"] == "elastix"]
+    assert [c["config"] for c in steps] == ["w1", "w1-x2"]
+    assert steps[1]["iterations"] == 400 and steps[1]["iterations_doubled"] == 800
+    assert steps[1]["converged"] and steps[1]["relative_change"] < 0.001
+    ran.clear()
+    study.sweep_and_repeat()  # converged at x4: nothing beyond it
+    assert ("elastix", 1.0, 1, 8) not in ran
+    monkeypatch.undo()
+    monkeypatch.setattr(run_study.common, "find_morea", lambda explicit=None: "morea")
     # MOREA, both configurations, from the GPU (no fields).
     for seed in (1, 2):
         _run(out, "morea", "default", seed, _scores(2.1, bone=0.2, dice=0.96),
