@@ -5,6 +5,7 @@ registration `morea register` (MOREA_BIN) on a worker."""
 import csv
 import json
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -134,6 +135,14 @@ def _parent_of(pid):
         return int(f.read().rsplit(")", 1)[1].split()[1])
 
 
+def _last_generation(log):
+    """The last generation a registration's log reports (0: none yet)."""
+    if not log.exists():
+        return 0
+    found = re.findall(rf"generation (\d+)/{KILL_GENERATIONS}", log.read_text())
+    return int(found[-1]) if found else 0
+
+
 def test_a_killed_worker_s_registration_resumes_from_its_checkpoint_to_the_same_front(problems, tmp_path):
     out = tmp_path / "batch"
     rows = [{"id": rid, "problem": str(problems / "pelvis"), "seed": 5} for rid in ("killed", "whole")]
@@ -152,10 +161,13 @@ def test_a_killed_worker_s_registration_resumes_from_its_checkpoint_to_the_same_
     batch = threading.Thread(target=run)
     batch.start()
     try:
-        # Once the registration has checkpointed past generation 10, kill the worker running it.
+        # Once the checkpoint of generation 10 is whole, kill the worker running it.
+        # Checkpoints are written behind the run, one at a time (the next one
+        # starts only after it), and a generation is logged after its own
+        # checkpoint has started: a logged generation past 10 means 10 is on disk.
         log = out / "logs" / "killed.log"
         deadline = time.monotonic() + 240
-        while not (log.exists() and f"generation 10/{KILL_GENERATIONS}" in log.read_text()):
+        while _last_generation(log) <= 10:
             assert time.monotonic() < deadline and batch.is_alive(), outcome.get("error")
             time.sleep(0.2)
         assert (out / "killed" / "checkpoint.bin").exists()
