@@ -40,7 +40,8 @@ GreedyEdgeCover(const MeshTopology & topology);
  *  A group starts at the free point with the fewest free neighbours and
  *  takes the free neighbour nearest its first point until it is full; a
  *  group left with fewer than half that joins its smallest neighbouring
- *  group. `size` 1 gives one group per point. */
+ *  group when the two hold at most twice the size. No group is larger than
+ *  that; `size` 1 gives one group per point. */
 std::vector<std::vector<std::uint32_t>>
 GreedyPointGroups(const MeshTopology & topology, const std::vector<Vec3> & points, std::size_t size);
 

@@ -140,9 +140,9 @@ GreedyPointGroups(const MeshTopology & topology, const std::vector<Vec3> & point
       widen(q);
     }
   }
-  // Small groups join their smallest neighbouring group (the mesh is
-  // connected through shared tetrahedra, so a small group has neighbours
-  // unless it is the whole mesh).
+  // Small groups join their smallest neighbouring group, unless that would
+  // make it larger than twice the size (the mesh is connected through shared
+  // tetrahedra, so a small group has neighbours unless it is the whole mesh).
   const std::size_t smallest = (size + 1) / 2;
   std::vector<bool> merged(groups.size(), false);
   for (std::size_t g = 0; g < groups.size(); ++g)
@@ -158,7 +158,7 @@ GreedyPointGroups(const MeshTopology & topology, const std::vector<Vec3> & point
                        (groups[h].size() == groups[target].size() && h < target)))
           target = h;
       }
-    if (target == groups.size())
+    if (target == groups.size() || groups[target].size() + groups[g].size() > 2 * size)
       continue;
     for (std::uint32_t p : groups[g])
     {

@@ -75,7 +75,9 @@ DeriveMeshModelParts(const RegistrationProblem & problem, const morea_core::Para
   else
   {
     const std::size_t points = model.base.NumberOfPoints();
-    const std::size_t size = std::max<std::size_t>(2, (points + fosElements - 1) / fosElements);
+    // At most 16 points (96 variables) per group, so that merged groups stay
+    // within what the CUDA fold check handles (MaxRepairElementPoints, 64).
+    const std::size_t size = std::clamp<std::size_t>((points + fosElements - 1) / fosElements, 2, 16);
     model.parallel = morea_core::BuildParallelStructure(
       model.topology, morea_core::GreedyPointGroups(model.topology, model.base.points, size));
     model.report.notes.push_back("FOS elements: " + std::to_string(model.parallel.elements.size()) +
