@@ -299,9 +299,10 @@ class Study:
                 # Double until the score changes by < 1 % or the largest scale ran.
                 scale = 2
                 self.run_one(m, best, 1, scale=scale)
-                while (scale < self.settings.get("convergence_max_scale", 2)
-                       and self.convergence_step(m, best, scale // 2) is not None
-                       and not self.convergence_step(m, best, scale // 2)["converged"]):
+                while scale < self.settings.get("convergence_max_scale", 2):
+                    step = self.convergence_step(m, best, scale // 2)
+                    if step is None or step["converged"]:
+                        break
                     scale *= 2
                     self.run_one(m, best, 1, scale=scale)
         for m in competitors:

@@ -124,17 +124,32 @@ TEST(CheckpointResume, OtherParametersOrImagesAreRefusedNamingTheKey)
   EXPECT_EQ(resumed.history.size(), 4u);
 }
 
-TEST(CheckpointResume, MultiLevelRunsRefineCarryOverAndResumeAcrossLevels)
+/** Two mesh levels, two generations on the first, on the CPU with 2 threads. */
+morea_core::ParameterSet
+TwoLevels(const morea_core::ParameterSet & base, const std::string & generations, const std::string & refinement)
 {
-  SmallRun              run;
-  morea_core::ParameterSet p = run.parameters;
-  p.SetFromString("ea_num_generations", "4");
+  morea_core::ParameterSet p = base;
+  p.SetFromString("ea_num_generations", generations);
   p.SetFromString("morea_max_num_mesh_levels", "2");
   p.SetFromString("morea_num_generations_per_level", "2");
-  p.SetFromString("morea_mesh_refinement_factor", "2");
-  MeshRegistrationOptions plain;
-  plain.backend = morea_core::BackendChoice::Cpu;
-  plain.threads = 2;
+  p.SetFromString("morea_mesh_refinement_factor", refinement);
+  return p;
+}
+
+MeshRegistrationOptions
+OnTheCpu()
+{
+  MeshRegistrationOptions options;
+  options.backend = morea_core::BackendChoice::Cpu;
+  options.threads = 2;
+  return options;
+}
+
+TEST(CheckpointResume, MultiLevelRunsRefineCarryOverAndResumeAcrossLevels)
+{
+  SmallRun                      run;
+  const morea_core::ParameterSet   p = TwoLevels(run.parameters, "4", "2");
+  const MeshRegistrationOptions plain = OnTheCpu();
   const MeshRegistrationResult whole = RegisterMeshes(run.problem, p, plain);
   const auto &                 mesh = whole.model.base;
   const auto midpoints = std::count(mesh.origins.begin(), mesh.origins.end(), morea_core::PointOrigin::Midpoint);
@@ -178,22 +193,14 @@ TEST(CheckpointResume, MultiLevelRunsRefineCarryOverAndResumeAcrossLevels)
 
 TEST(CheckpointResume, GroupedFosElementsOnTheRefinedLevel)
 {
-  SmallRun              run;
-  morea_core::ParameterSet p = run.parameters;
-  p.SetFromString("ea_num_generations", "3");
-  p.SetFromString("morea_max_num_mesh_levels", "2");
-  p.SetFromString("morea_num_generations_per_level", "2");
-  p.SetFromString("morea_mesh_refinement_factor", "3");
+  SmallRun                run;
+  morea_core::ParameterSet p = TwoLevels(run.parameters, "3", "3");
   p.SetFromString("morea_fos_type", "coarse-groups");
-  MeshRegistrationOptions options;
-  options.backend = morea_core::BackendChoice::Cpu;
-  options.threads = 2;
-  const MeshRegistrationResult result = RegisterMeshes(run.problem, p, options);
+  const MeshRegistrationResult result = RegisterMeshes(run.problem, p, OnTheCpu());
   const auto &                 model = result.model;
   // Groups (about the first level's element count): far fewer than the refined
   // mesh's edges; every point in one of them.
-  const morea_core::ParallelStructure edges = morea_core::BuildParallelStructure(
-    morea_core::MeshTopology(result.model.base.tetrahedra, result.model.base.NumberOfPoints()));
+  const morea_core::ParallelStructure edges = morea_core::BuildParallelStructure(model.topology);
   EXPECT_LT(model.parallel.elements.size(), edges.elements.size() / 2);
   std::vector<int> coveredBy(model.base.NumberOfPoints(), 0);
   for (const auto & e : model.parallel.elements)

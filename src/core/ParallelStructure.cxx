@@ -144,7 +144,6 @@ GreedyPointGroups(const MeshTopology & topology, const std::vector<Vec3> & point
   // make it larger than twice the size (the mesh is connected through shared
   // tetrahedra, so a small group has neighbours unless it is the whole mesh).
   const std::size_t smallest = (size + 1) / 2;
-  std::vector<bool> merged(groups.size(), false);
   for (std::size_t g = 0; g < groups.size(); ++g)
   {
     if (groups[g].size() >= smallest)
@@ -165,15 +164,14 @@ GreedyPointGroups(const MeshTopology & topology, const std::vector<Vec3> & point
       group[p] = static_cast<std::uint32_t>(target);
       groups[target].push_back(p);
     }
-    groups[g].clear();
-    merged[g] = true;
+    groups[g].clear(); // merged (no other group is empty)
   }
   std::vector<std::vector<std::uint32_t>> result;
-  for (std::size_t g = 0; g < groups.size(); ++g)
-    if (!merged[g])
+  for (auto & g : groups)
+    if (!g.empty())
     {
-      std::sort(groups[g].begin(), groups[g].end());
-      result.push_back(std::move(groups[g]));
+      std::sort(g.begin(), g.end());
+      result.push_back(std::move(g));
     }
   return result;
 }
