@@ -219,4 +219,29 @@ TEST(CheckpointResume, GroupedFosElementsOnTheRefinedLevel)
   for (const auto & s : result.front)
     EXPECT_TRUE(constraint.Evaluate(s.mesh).Feasible());
 }
+
+TEST(CheckpointResume, AFinishedRunGoesOnForLongerToTheLongerRunsFront)
+{
+  // A run that ended at its budget, resumed with a larger one, reaches the
+  // front the larger budget reaches from the start (what docs/parameters.md
+  // tells users who find their run not converged).
+  SmallRun                     run;
+  const MeshRegistrationResult finished = run.Run(run.parameters, run.problem);
+  ASSERT_EQ(finished.history.size(), 3u);
+  morea_core::ParameterSet longer = run.parameters;
+  longer.SetFromString("ea_num_generations", "4");
+  const MeshRegistrationResult extended = run.Run(longer, run.problem);
+  EXPECT_EQ(extended.resumedAtGeneration, 2u);
+  const MeshRegistrationResult straight = RegisterMeshes(run.problem, longer, OnTheCpu());
+  ASSERT_EQ(extended.history.size(), straight.history.size());
+  for (std::size_t g = 0; g < straight.history.size(); ++g)
+    EXPECT_EQ(extended.history[g].hypervolume, straight.history[g].hypervolume) << "generation " << g;
+  ASSERT_FALSE(straight.front.empty());
+  ASSERT_EQ(extended.front.size(), straight.front.size());
+  for (std::size_t i = 0; i < straight.front.size(); ++i)
+  {
+    EXPECT_EQ(extended.front[i].fitness.objectives, straight.front[i].fitness.objectives);
+    EXPECT_EQ(extended.front[i].mesh.target, straight.front[i].mesh.target);
+  }
+}
 } // namespace
