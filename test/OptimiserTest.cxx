@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -20,6 +21,7 @@
 #include <numeric>
 #include <random>
 #include <sstream>
+#include <thread>
 #include <utility>
 
 using namespace morea_core;
@@ -32,8 +34,12 @@ namespace
 class ShufflingBackend final : public EvaluationBackend
 {
 public:
-  explicit ShufflingBackend(const TetrahedronEvaluator & evaluator)
+  /** `pause`: how long it waits between the caller's meanwhile and the
+   *  first hand-over, as a device's evaluation may take. */
+  explicit ShufflingBackend(const TetrahedronEvaluator & evaluator,
+                            std::chrono::milliseconds pause = std::chrono::milliseconds(0))
     : m_Cpu(CreateCpuEvaluationBackend(evaluator, 2))
+    , m_Pause(pause)
   {}
   std::string
   Name() const override
@@ -70,6 +76,7 @@ public:
     // After the evaluation (the CPU backend calls it before).
     if (meanwhile)
       meanwhile();
+    std::this_thread::sleep_for(m_Pause);
     // Handed over in parts of random sizes, as a device backend may.
     for (std::size_t begin = 0; ready && begin < candidates.size();)
     {
@@ -93,6 +100,7 @@ public:
 private:
   std::unique_ptr<EvaluationBackend> m_Cpu;
   std::mt19937                       m_Random{ 99 };
+  std::chrono::milliseconds          m_Pause;
 };
 
 std::vector<ObjectiveVector>
@@ -243,6 +251,13 @@ TEST(MoRvGomea, DrawingBatchesAheadChangesNoDecision)
     ShufflingBackend shuffling(*problem.evaluator); // handed over in parts of random sizes
     EXPECT_EQ(a, RunToEnd(problem, shuffling, ahead)) << threads << " draw-ahead threads, shuffled";
   }
+  // The draw-ahead threads done before the acceptance starts, as beside a
+  // device on a quiet machine, and (above) late, as on a busy one: the
+  // models they draw from must not depend on how far the acceptance is.
+  GomeaOptions     ahead = here;
+  ahead.drawAheadThreads = 2;
+  ShufflingBackend pausing(*problem.evaluator, std::chrono::milliseconds(5));
+  EXPECT_EQ(a, RunToEnd(problem, pausing, ahead)) << "draw-ahead threads with the acceptance after a pause";
   // Without the split of the first group, too (a generation's first two
   // batches are then two groups, and the batches are fewer).
   GomeaOptions whole = here;
