@@ -35,12 +35,13 @@ case "${1:-}" in
     }
     nvidia-smi --query-gpu=name --format=csv,noheader | tee "$out/gpu.txt"
     register alone
-    for k in $(seq 1 "$copies"); do register "side-$k" & done
+    names=()
+    for k in $(seq 1 "$copies"); do
+      names+=("side-$k")
+      register "side-$k" &
+    done
     wait
-    names=""
-    for k in $(seq 1 "$copies"); do names="$names side-$k"; done
-    # shellcheck disable=SC2086
-    python3 - /tmp/repro $names <<'EOF' | tee "$out/reproducibility.txt"
+    python3 - /tmp/repro "${names[@]}" <<'EOF' | tee "$out/reproducibility.txt"
 import csv, json, sys
 from pathlib import Path
 
@@ -63,12 +64,11 @@ same = 0
 for name in copies:
     other = rows(name)
     first = next((i for i, (a, b) in enumerate(zip(alone, other)) if a != b), None)
-    if first is None and len(other) == len(alone) and front(name) == front("alone"):
-        same += 1
-        print(f"{name}: identical (every generation and the front)")
-        continue
     if first is None:
-        print(f"{name}: the same generations, another front or length")
+        identical = len(other) == len(alone) and front(name) == front("alone")
+        same += identical
+        print(f"{name}: " + ("identical (every generation and the front)" if identical
+                             else "the same generations, another front or length"))
         continue
     a, b = alone[first], other[first]
     differing = [k for k in KEEP if a[k] != b[k]]
