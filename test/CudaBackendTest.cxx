@@ -15,11 +15,14 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <iostream>
 #include <limits>
 #include <numeric>
 #include <string>
+#include <thread>
 #include <vector>
 
 using namespace morea_core;
@@ -1072,6 +1075,128 @@ TEST(CudaEvaluationBackend, CandidatesStartedEarlyGetTheValuesOfAWholeBatch)
   early->StartNextPartials(whole.candidates, 10, nullptr);
   early->EvaluatePartials(whole.candidates);
   EXPECT_EQ(early->Statistics().startedCandidates, started);
+}
+
+TEST(CudaEvaluationBackend, ABatchStartedEarlyKeepsItsRestWhenTheNextBatchStartsEarly)
+{
+  MOREA_REQUIRE_CUDA_DEVICE();
+  OptimiserTestProblem problem;
+  const auto           population = problem.InitialPopulation(problem.Options());
+  std::size_t          itemsPerParent = 0;
+  for (std::uint32_t e : problem.parallel.groups[1])
+    itemsPerParent += problem.parallel.elements[e].dependentTetrahedra.size();
+  ASSERT_GT(itemsPerParent, 0u);
+  std::vector<DualMesh> parents;
+  for (std::size_t i = 0; parents.size() * itemsPerParent < 450000; ++i)
+    parents.push_back(population[i % population.size()]);
+  // Three batches in a row, as the optimiser runs them: `next` starts early
+  // behind `first` and its rest follows in one part; `third` starts early
+  // behind the head of `next`, whole.
+  morea_test::RandomCandidates first(problem, parents, problem.parallel.groups[0], 3.0, 41);
+  morea_test::RandomCandidates next(problem, parents, problem.parallel.groups[1], 3.0, 42);
+  // The third takes the parents in reverse order: its candidates' parents lie
+  // in other slots of the device's store than those of `next` at the same place.
+  const std::vector<DualMesh>  reversed(parents.rbegin(), parents.rend());
+  morea_test::RandomCandidates third(problem, reversed, problem.parallel.groups[0], 3.0, 43);
+  morea_test::RandomCandidates whole(problem, parents, problem.parallel.groups[1], 3.0, 42);
+  const auto parentIndex = [&](const PartialCandidate & c) { return static_cast<std::size_t>(c.parent - parents.data()); };
+  for (auto * batch : { &first, &next, &whole })
+    for (PartialCandidate & c : batch->candidates)
+      c.parentKey = parentIndex(c) + 1;
+  for (PartialCandidate & c : third.candidates)
+    c.parentKey = parents.size() - static_cast<std::size_t>(c.parent - reversed.data());
+  for (auto * batch : { &first, &next, &third, &whole })
+    for (PartialCandidate & c : batch->candidates)
+      c.evaluateFolded = true;
+  // The sums: what the optimiser's acceptance reads of every candidate.
+  std::vector<TetrahedronValues> nextSums(next.candidates.size()), wholeSums(whole.candidates.size());
+  for (std::size_t i = 0; i < next.candidates.size(); ++i)
+  {
+    next.candidates[i].sum = &nextSums[i];
+    whole.candidates[i].sum = &wholeSums[i];
+  }
+  FoldHandling handling;
+  handling.constraint = problem.constraint.get();
+  handling.base = &problem.base;
+  handling.repair = true;
+  auto backend = CreateCudaEvaluationBackend(*problem.evaluator, 2, CudaInterpolation::Texture);
+  auto reference = CreateCudaEvaluationBackend(*problem.evaluator, 2, CudaInterpolation::Texture);
+  backend->SetFoldHandling(handling);
+  reference->SetFoldHandling(handling);
+  reference->EvaluatePartials(whole.candidates);
+  // The repair moves the points in place: each round starts from the drawn ones.
+  const auto drawnSource = next.source, drawnTarget = next.target;
+  for (int round = 0; round < 8; ++round)
+  {
+    for (std::size_t i = 0; i < next.candidates.size(); ++i)
+    {
+      std::copy(drawnSource[i].begin(), drawnSource[i].end(), next.source[i].begin());
+      std::copy(drawnTarget[i].begin(), drawnTarget[i].end(), next.target[i].begin());
+    }
+    std::size_t headOfNext = 0;
+    backend->EvaluatePartials(
+      first.candidates,
+      [&](std::size_t, std::size_t end) {
+        if (end == first.candidates.size())
+          return;
+        const std::size_t pending = parentIndex(first.candidates[end]);
+        std::size_t       head = 0;
+        while (head < next.candidates.size() && parentIndex(next.candidates[head]) < pending)
+          ++head;
+        backend->StartNextPartials(next.candidates, head, nullptr);
+        headOfNext = head;
+      },
+      [&] { backend->PrepareNextPartials(next.candidates); });
+    // The device reaches the rest of `next` only once the third batch has
+    // started (as when other processes' work shares the device): the rest's
+    // uploads wait while the host stages the third's head. A watchdog
+    // releases the device should that hand-over never come.
+    std::atomic<bool> release{ false };
+    bool              releasedByTheHandOver = false;
+    HoldCudaEvaluationStream(*backend, release);
+    struct Watchdog
+    {
+      std::atomic<bool> & release;
+      std::thread         thread;
+      ~Watchdog()
+      {
+        release.store(true);
+        thread.join();
+      }
+    } watchdog{ release, std::thread([&release] {
+                  for (int wait = 0; wait < 1000 && !release.load(); ++wait)
+                    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+                  release.store(true);
+                }) };
+    const std::uint64_t startedBefore = backend->Statistics().startedCandidates;
+    backend->EvaluatePartials(
+      next.candidates,
+      [&](std::size_t, std::size_t end) {
+        if (end != headOfNext)
+          return;
+        backend->StartNextPartials(third.candidates, third.candidates.size(), nullptr);
+        releasedByTheHandOver = !release.load();
+        release.store(true);
+      },
+      [&] { backend->PrepareNextPartials(third.candidates); });
+    ASSERT_TRUE(releasedByTheHandOver) << "round " << round << ": the head of `next` was not handed over alone";
+    const std::uint64_t startedNext = backend->Statistics().startedCandidates - startedBefore;
+    backend->EvaluatePartials(third.candidates);
+    ASSERT_GT(startedNext, 0u) << "round " << round << ": the second batch did not start early";
+    ASSERT_LT(startedNext, next.candidates.size()) << "round " << round << ": it has no rest";
+    ASSERT_EQ(backend->Statistics().startedCandidates - startedBefore, startedNext + third.candidates.size())
+      << "round " << round << ": the third batch did not start early";
+    for (std::size_t i = 0; i < next.candidates.size(); ++i)
+    {
+      ASSERT_EQ(next.folds[i].foldedSides, whole.folds[i].foldedSides) << "round " << round << " candidate " << i;
+      ASSERT_EQ(next.folds[i].repairedSides, whole.folds[i].repairedSides) << "round " << round << " candidate " << i;
+      ASSERT_EQ(nextSums[i].magnitude, wholeSums[i].magnitude) << "round " << round << " candidate " << i;
+      ASSERT_EQ(nextSums[i].intensity, wholeSums[i].intensity) << "round " << round << " candidate " << i;
+      ASSERT_EQ(nextSums[i].guidance, wholeSums[i].guidance) << "round " << round << " candidate " << i;
+      ASSERT_EQ(nextSums[i].samples, wholeSums[i].samples) << "round " << round << " candidate " << i;
+    }
+    nextSums.assign(nextSums.size(), TetrahedronValues{});
+  }
 }
 
 TEST(CudaEvaluationBackend, FoldChecksAndRepairAgreeWithTheCpu)

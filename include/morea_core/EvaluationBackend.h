@@ -14,6 +14,7 @@
 #include "morea_core/RefusalBound.h"
 #include "morea_core/TetrahedronObjectives.h"
 
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -399,6 +400,14 @@ enum class CudaInterpolation
 std::unique_ptr<EvaluationBackend>
 CreateCudaEvaluationBackend(const TetrahedronEvaluator & evaluator, std::size_t threads = 0,
                             CudaInterpolation interpolation = CudaInterpolation::Exact, int device = 0);
+
+/** For tests: queues on the CUDA backend's evaluation stream a wait until
+ *  `release` is set, so that the work queued after it waits while the host
+ *  goes on, as when other processes share the device. `release` must
+ *  outlive the wait. Throws morea_core::Error for another backend or
+ *  without CUDA. */
+void
+HoldCudaEvaluationStream(EvaluationBackend & backend, const std::atomic<bool> & release);
 
 enum class BackendChoice
 {

@@ -35,7 +35,7 @@ CudaEvaluationBackend::CheckStartedHead(const std::vector<PartialCandidate> & ca
   {
     const PartialCandidate & c = candidates[i];
     if (c.parentKey != m_ParentKeys[h.candidateParent[i]] ||
-        (f.checks && m_HostSkipIfFolded[i] != (c.folds && !c.evaluateFolded ? 1 : 0)))
+        (f.checks && f.hostSkipIfFolded[i] != (c.folds && !c.evaluateFolded ? 1 : 0)))
       throw Error("evaluation backend: candidates started early changed before their evaluation");
   }
 }

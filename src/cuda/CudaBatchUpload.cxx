@@ -338,7 +338,6 @@ CudaEvaluationBackend::UploadTables(const std::vector<PartialCandidate> & candid
                 " points, not " + std::to_string(h.largestChecked));
   Check(cudaEventRecord(staged.Get(), m_Stream->Get()), "recording an event");
   m_ParentKeys.assign(h.parents.size(), 0);
-  m_HostCandidateSlot.Reserve(n);
   m_CandidateParent.Reserve(n);
   m_Batch.candidateParent = m_CandidateParent.Data();
   m_Batch.elementPointOffsets = StageAndUpload(h.pointOffsets, m_HostElementPointOffsets, m_ElementPointOffsets);
@@ -359,7 +358,6 @@ CudaEvaluationBackend::UploadTables(const std::vector<PartialCandidate> & candid
   {
     m_FoldCheck = UploadAsync(h.foldCheck.Data(), n, m_FoldCheckDevice);
     m_SideSeeds = UploadAsync(h.sideSeeds.Data(), 2 * n, m_SideSeedsDevice);
-    m_HostSkipIfFolded.Reserve(n);
     m_SkipIfFoldedDevice.Reserve(n);
     m_SkipIfFolded = m_SkipIfFoldedDevice.Data();
   }
@@ -389,21 +387,21 @@ CudaEvaluationBackend::UploadRange(const std::vector<PartialCandidate> & candida
   for (std::size_t p = pBegin; p < pEnd; ++p)
     m_ParentSlot[p] = slots.slot[p - pBegin];
   for (std::size_t i = begin; i < end; ++i)
-    m_HostCandidateSlot[i] = m_ParentSlot[h.candidateParent[i]];
+    f.hostCandidateSlot[i] = m_ParentSlot[h.candidateParent[i]];
   const std::vector<const DualMesh *> parents(h.parents.begin() + static_cast<std::ptrdiff_t>(pBegin),
                                               h.parents.begin() + static_cast<std::ptrdiff_t>(pEnd));
   UploadParents(parents, slots, m_ParentStaging[begin == 0 ? 0 : 1]);
   cudaStream_t stream = m_Stream->Get();
-  Check(cudaMemcpyAsync(m_CandidateParent.Data() + begin, m_HostCandidateSlot.Data() + begin,
+  Check(cudaMemcpyAsync(m_CandidateParent.Data() + begin, f.hostCandidateSlot.Data() + begin,
                         (end - begin) * sizeof(std::uint32_t), cudaMemcpyHostToDevice, stream),
         "copying a batch to the device");
   if (!checks)
     return;
   m_Pool->ParallelFor(end - begin, [&](std::size_t k) {
     const PartialCandidate & c = candidates[begin + k];
-    m_HostSkipIfFolded[begin + k] = c.folds && !c.evaluateFolded ? 1 : 0;
+    f.hostSkipIfFolded[begin + k] = c.folds && !c.evaluateFolded ? 1 : 0;
   });
-  Check(cudaMemcpyAsync(m_SkipIfFoldedDevice.Data() + begin, m_HostSkipIfFolded.Data() + begin, end - begin,
+  Check(cudaMemcpyAsync(m_SkipIfFoldedDevice.Data() + begin, f.hostSkipIfFolded.Data() + begin, end - begin,
                         cudaMemcpyHostToDevice, stream),
         "copying a batch to the device");
 }
@@ -473,10 +471,12 @@ CudaEvaluationBackend::BeginFlight(const std::vector<PartialCandidate> & candida
     f.hostSchedule.Reserve(2 * n);
     f.schedule.Reserve(2 * n);
   }
+  f.hostCandidateSlot.Reserve(std::max<std::size_t>(1, n));
   if (f.checks)
   {
     f.outcome.Reserve(2 * n);
     f.hostOutcome.Reserve(2 * n);
+    f.hostSkipIfFolded.Reserve(n);
   }
   f.ranges = 0;
   f.candidateBounds.assign(1, 0);

@@ -4,6 +4,8 @@
 // CudaEvaluationBackend.h).
 #include "CudaEvaluationBackend.h"
 
+#include <thread>
+
 namespace morea_core
 {
 namespace cudabackend
@@ -270,6 +272,17 @@ CudaEvaluationBackend::EvaluatePartials(const std::vector<PartialCandidate> & ca
 }
 
 void
+CudaEvaluationBackend::HoldStream(const std::atomic<bool> & release)
+{
+  SelectDevice();
+  const auto wait = [](void * flag) {
+    while (!static_cast<const std::atomic<bool> *>(flag)->load())
+      std::this_thread::yield();
+  };
+  Check(cudaLaunchHostFunc(m_Stream->Get(), wait, const_cast<std::atomic<bool> *>(&release)), "holding the stream");
+}
+
+void
 CudaEvaluationBackend::PrepareNextPartials(const std::vector<PartialCandidate> & next)
 {
   SelectDevice();
@@ -507,6 +520,15 @@ CudaEvaluationBackend::SelectDevice() const
   Check(cudaSetDevice(m_Device), ("selecting CUDA device " + std::to_string(m_Device)).c_str());
 }
 } // namespace cudabackend
+
+void
+HoldCudaEvaluationStream(EvaluationBackend & backend, const std::atomic<bool> & release)
+{
+  auto * cuda = dynamic_cast<cudabackend::CudaEvaluationBackend *>(&backend);
+  if (!cuda)
+    throw Error("holding the evaluation stream: not the CUDA backend");
+  cuda->HoldStream(release);
+}
 
 std::unique_ptr<EvaluationBackend>
 CreateCudaEvaluationBackend(const TetrahedronEvaluator & evaluator, std::size_t threads,

@@ -171,6 +171,12 @@ struct BatchFlight
   cuda::DeviceArray<double>        candidateSums;
   cuda::PinnedArray<double>        hostCandidateSums;
   std::vector<std::uint8_t>        valuesWritten; ///< per candidate: its values are on the host (SampleSkipped)
+  /** Per candidate its parent's slot in the store and whether, left folded,
+   *  it needs no values, staged for their upload range by range. Per flight:
+   *  the next batch's head is staged while this batch's rest may still wait
+   *  for its copy (behind other processes' work on a shared device). */
+  cuda::PinnedArray<std::uint32_t> hostCandidateSlot;
+  cuda::PinnedArray<std::uint8_t>  hostSkipIfFolded;
   cuda::DeviceArray<std::uint8_t>  outcome; ///< per candidate side: the fold checks' outcome
   cuda::PinnedArray<std::uint8_t>  hostOutcome;
   cuda::PinnedArray<std::uint32_t> hostChunks; ///< per part: the texture set-up's number of chunks
@@ -304,6 +310,10 @@ public:
 
   void
   PrepareNextPartials(const std::vector<PartialCandidate> & next) override;
+
+  /** HoldCudaEvaluationStream. */
+  void
+  HoldStream(const std::atomic<bool> & release);
 
   /** Starts the first `head` candidates of the prepared next batch, behind
    *  the current batch's last part: their parents go up, their folds are
@@ -714,7 +724,7 @@ private:
   } m_Head;
   bool m_AcceptHead{ false }; ///< StartNextPartials may start a head now
   cuda::PinnedArray<std::uint32_t> m_HostElementPointOffsets, m_HostElementPoints, m_HostElementTetrahedronOffsets,
-    m_HostElementTetrahedra, m_HostCandidateSlot;
+    m_HostElementTetrahedra;
   HostCandidates                   m_HostCandidates[2];
   int                              m_CurrentHost{ 0 }; ///< the one of the batch in flight (or last)
 
@@ -729,7 +739,6 @@ private:
   const std::uint64_t *            m_SideSeeds{ nullptr };
   cuda::DeviceArray<std::uint8_t>  m_FoldCheckDevice, m_SkipIfFoldedDevice;
   cuda::DeviceArray<std::uint64_t> m_SideSeedsDevice;
-  cuda::PinnedArray<std::uint8_t>  m_HostSkipIfFolded;
   // The sampling of the candidates a refusal screen skipped that the
   // optimiser needs after all.
   std::unique_ptr<cuda::Stream>                m_FallbackStream;

@@ -47,6 +47,12 @@ MeasureTrilinearFetchRate()
   throw Error("fetch-rate probe: " + CudaUnavailableReason());
 }
 
+void
+HoldCudaEvaluationStream(EvaluationBackend &, const std::atomic<bool> &)
+{
+  throw Error("holding the evaluation stream: " + CudaUnavailableReason());
+}
+
 std::unique_ptr<EvaluationBackend>
 CreateCudaEvaluationBackend(const TetrahedronEvaluator &, std::size_t, CudaInterpolation, int)
 {
