@@ -108,6 +108,53 @@ ExpectSameDecisions(const std::pair<std::vector<ArchiveEntry>, std::vector<Gener
   for (std::size_t g = 0; g < a.second.size(); ++g)
     EXPECT_EQ(a.second[g].accepted, b.second[g].accepted) << name << " generation " << g;
 }
+/** Parents enough for batches of several parts (the backend splits batches
+ *  of hundreds of thousands of tetrahedra), each with the elements of one of
+ *  `groups` (counted by the group with the fewest tetrahedra), parent after
+ *  parent (as the optimiser orders them). */
+std::vector<DualMesh>
+ParentsForBatchesInParts(const OptimiserTestProblem & problem, const std::vector<std::size_t> & groups)
+{
+  const auto  population = problem.InitialPopulation(problem.Options());
+  std::size_t itemsPerParent = std::numeric_limits<std::size_t>::max();
+  for (std::size_t g : groups)
+  {
+    std::size_t items = 0;
+    for (std::uint32_t e : problem.parallel.groups[g])
+      items += problem.parallel.elements[e].dependentTetrahedra.size();
+    itemsPerParent = std::min(itemsPerParent, items);
+  }
+  if (groups.empty() || itemsPerParent == 0)
+    throw Error("test problem: the groups need dependent tetrahedra");
+  std::vector<DualMesh> parents;
+  for (std::size_t i = 0; parents.size() * itemsPerParent < 450000; ++i)
+    parents.push_back(population[i % population.size()]);
+  return parents;
+}
+
+/** Fold checks with the repair, on the problem's base mesh. */
+FoldHandling
+RepairingFoldHandling(const OptimiserTestProblem & problem)
+{
+  FoldHandling handling;
+  handling.constraint = problem.constraint.get();
+  handling.base = &problem.base;
+  handling.repair = true;
+  return handling;
+}
+
+/** The first candidates of `next` whose parents (of one array, in order)
+ *  come before that of candidate `end` of `first`: those that the hand-over
+ *  of `first` up to `end` has finished with. */
+std::size_t
+HeadFinishedWith(const std::vector<PartialCandidate> & first, std::size_t end,
+                 const std::vector<PartialCandidate> & next)
+{
+  std::size_t head = 0;
+  while (head < next.size() && next[head].parent < first[end].parent)
+    ++head;
+  return head;
+}
 } // namespace
 
 TEST(CudaEvaluationBackend, WholeSolutionsAgreeWithTheCpu)
@@ -953,23 +1000,8 @@ TEST(CudaEvaluationBackend, ParentsWithKeysAreKeptOnTheDevice)
 TEST(CudaEvaluationBackend, CandidatesStartedEarlyGetTheValuesOfAWholeBatch)
 {
   MOREA_REQUIRE_CUDA_DEVICE();
-  OptimiserTestProblem problem;
-  const auto           population = problem.InitialPopulation(problem.Options());
-  // Enough parents for batches of several parts (the backend splits batches
-  // of hundreds of thousands of tetrahedra), each parent with the elements of
-  // one group, parent after parent (as the optimiser orders them).
-  std::size_t itemsPerParent = 0;
-  for (std::size_t g = 0; g < 2; ++g)
-  {
-    std::size_t items = 0;
-    for (std::uint32_t e : problem.parallel.groups[g])
-      items += problem.parallel.elements[e].dependentTetrahedra.size();
-    itemsPerParent = g == 0 ? items : std::min(itemsPerParent, items);
-  }
-  ASSERT_GT(itemsPerParent, 0u);
-  std::vector<DualMesh> parents;
-  for (std::size_t i = 0; parents.size() * itemsPerParent < 450000; ++i)
-    parents.push_back(population[i % population.size()]);
+  OptimiserTestProblem        problem;
+  const std::vector<DualMesh> parents = ParentsForBatchesInParts(problem, { 0, 1 });
   morea_test::RandomCandidates first(problem, parents, problem.parallel.groups[0], 3.0, 41);
   morea_test::RandomCandidates next(problem, parents, problem.parallel.groups[1], 3.0, 42);
   morea_test::RandomCandidates whole(problem, parents, problem.parallel.groups[1], 3.0, 42);
@@ -980,10 +1012,7 @@ TEST(CudaEvaluationBackend, CandidatesStartedEarlyGetTheValuesOfAWholeBatch)
       c.parentKey = parentIndex(c) + 1;
       c.evaluateFolded = parentIndex(c) % 3 != 0;
     }
-  FoldHandling handling;
-  handling.constraint = problem.constraint.get();
-  handling.base = &problem.base;
-  handling.repair = true;
+  const FoldHandling handling = RepairingFoldHandling(problem);
   auto early = CreateCudaEvaluationBackend(*problem.evaluator, 2, CudaInterpolation::Texture);
   auto late = CreateCudaEvaluationBackend(*problem.evaluator, 2, CudaInterpolation::Texture);
   early->SetFoldHandling(handling);
@@ -1012,13 +1041,8 @@ TEST(CudaEvaluationBackend, CandidatesStartedEarlyGetTheValuesOfAWholeBatch)
     first.candidates,
     [&](std::size_t, std::size_t end) {
       ++ranges;
-      if (end == first.candidates.size())
-        return;
-      const std::size_t pending = parentIndex(first.candidates[end]);
-      std::size_t       head = 0;
-      while (head < next.candidates.size() && parentIndex(next.candidates[head]) < pending)
-        ++head;
-      early->StartNextPartials(next.candidates, head, &screen);
+      if (end < first.candidates.size())
+        early->StartNextPartials(next.candidates, HeadFinishedWith(first.candidates, end, next.candidates), &screen);
     },
     [&] { early->PrepareNextPartials(next.candidates); });
   ASSERT_GE(ranges, 2u) << "the batch was not handed over in parts";
@@ -1080,15 +1104,8 @@ TEST(CudaEvaluationBackend, CandidatesStartedEarlyGetTheValuesOfAWholeBatch)
 TEST(CudaEvaluationBackend, ABatchStartedEarlyKeepsItsRestWhenTheNextBatchStartsEarly)
 {
   MOREA_REQUIRE_CUDA_DEVICE();
-  OptimiserTestProblem problem;
-  const auto           population = problem.InitialPopulation(problem.Options());
-  std::size_t          itemsPerParent = 0;
-  for (std::uint32_t e : problem.parallel.groups[1])
-    itemsPerParent += problem.parallel.elements[e].dependentTetrahedra.size();
-  ASSERT_GT(itemsPerParent, 0u);
-  std::vector<DualMesh> parents;
-  for (std::size_t i = 0; parents.size() * itemsPerParent < 450000; ++i)
-    parents.push_back(population[i % population.size()]);
+  OptimiserTestProblem        problem;
+  const std::vector<DualMesh> parents = ParentsForBatchesInParts(problem, { 1 });
   // Three batches in a row, as the optimiser runs them: `next` starts early
   // behind `first` and its rest follows in one part; `third` starts early
   // behind the head of `next`, whole.
@@ -1115,10 +1132,7 @@ TEST(CudaEvaluationBackend, ABatchStartedEarlyKeepsItsRestWhenTheNextBatchStarts
     next.candidates[i].sum = &nextSums[i];
     whole.candidates[i].sum = &wholeSums[i];
   }
-  FoldHandling handling;
-  handling.constraint = problem.constraint.get();
-  handling.base = &problem.base;
-  handling.repair = true;
+  const FoldHandling handling = RepairingFoldHandling(problem);
   auto backend = CreateCudaEvaluationBackend(*problem.evaluator, 2, CudaInterpolation::Texture);
   auto reference = CreateCudaEvaluationBackend(*problem.evaluator, 2, CudaInterpolation::Texture);
   backend->SetFoldHandling(handling);
@@ -1139,12 +1153,8 @@ TEST(CudaEvaluationBackend, ABatchStartedEarlyKeepsItsRestWhenTheNextBatchStarts
       [&](std::size_t, std::size_t end) {
         if (end == first.candidates.size())
           return;
-        const std::size_t pending = parentIndex(first.candidates[end]);
-        std::size_t       head = 0;
-        while (head < next.candidates.size() && parentIndex(next.candidates[head]) < pending)
-          ++head;
-        backend->StartNextPartials(next.candidates, head, nullptr);
-        headOfNext = head;
+        headOfNext = HeadFinishedWith(first.candidates, end, next.candidates);
+        backend->StartNextPartials(next.candidates, headOfNext, nullptr);
       },
       [&] { backend->PrepareNextPartials(next.candidates); });
     // The device reaches the rest of `next` only once the third batch has
