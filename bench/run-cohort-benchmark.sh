@@ -12,6 +12,10 @@
 #   bench/run-cohort-benchmark.sh device-carry/bundle.tar.xz [N] [PARAMETERS.toml]
 # Results: $RESULTS (default ./cohort-benchmark). DEADLINE=S stops the
 # one-GPU cohort S seconds after the start (its finished registrations are kept).
+# SAMPLE_MS=0 turns the nvidia-smi sampling (every 500 ms) off.
+# RUNS="all-gpus" or RUNS="one-gpu" runs one of the two cohorts (default both),
+# for a lease whose command time limit is shorter than both together; the
+# ratio is then the two calls' wall times, on the same machine while it is held.
 set -uo pipefail
 bundle=$1
 n=${2:-8}
@@ -29,9 +33,12 @@ wait
 gpus=$(nvidia-smi --query-gpu=index --format=csv,noheader 2>/dev/null | paste -sd, -)
 gpus=${gpus:-0,1}
 echo "GPUs: $gpus; $(nproc) cores; bundle ready after $(( $(date +%s) - t0 )) s"
-nvidia-smi --query-gpu=timestamp,index,utilization.gpu,memory.used --format=csv,noheader -lms 500 \
-  > "$out/nvidia-smi.csv" 2>/dev/null &
-smi=$!
+smi=""
+if [ "${SAMPLE_MS:-500}" -gt 0 ]; then
+  nvidia-smi --query-gpu=timestamp,index,utilization.gpu,memory.used --format=csv,noheader -lms "${SAMPLE_MS:-500}" \
+    > "$out/nvidia-smi.csv" 2>/dev/null &
+  smi=$!
+fi
 
 run() { # NAME GPUS [TIMEOUT]
   local name=$1 start end
@@ -50,11 +57,12 @@ run() { # NAME GPUS [TIMEOUT]
   cat "$out/$name-nvidia-smi.txt"
 }
 
-run all-gpus "$gpus"
+runs=${RUNS:-all-gpus one-gpu}
+case " $runs " in *" all-gpus "*) run all-gpus "$gpus" ;; esac
 left=""
 if [ -n "${DEADLINE:-}" ]; then left=$(( DEADLINE - ($(date +%s) - t0) )); fi
-run one-gpu 0 $left
-kill $smi 2>/dev/null
+case " $runs " in *" one-gpu "*) run one-gpu 0 $left ;; esac
+[ -n "$smi" ] && kill $smi 2>/dev/null
 grep -h "^times:" "$work"/one-gpu/logs/*.log > "$out/one-gpu-times.txt" 2>/dev/null
 $b/bin/python3 - "$out/times.txt" <<'EOF'
 import re, sys
