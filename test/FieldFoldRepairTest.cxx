@@ -11,6 +11,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <vector>
 
 namespace
 {
@@ -140,6 +142,47 @@ TEST(FieldFoldRepair, CompressedTetrahedraOfAFoldFreeMeshAreRepaired)
   EXPECT_LT(changed, grid.NumberOfVoxels() / 50) << "the rest keeps the exact piecewise-affine map";
   // Displacements here reach 0.45 x 8 mm per axis; the repair moves far less.
   EXPECT_LT(report.maximumChange, 2.0);
+}
+
+TEST(FieldFoldRepair, SplitsItsReportBetweenVoxelsTheMeshCoversAndTheRest)
+{
+  // Two spikes, one in a region marked outside the mesh (i >= 15); the mask
+  // splits the report and leaves the repair exactly as without it.
+  auto field = Grid({ { 21, 21, 21 } }, { { 1.0, 1.0, 1.0 } });
+  for (std::size_t k = 0; k < 21; ++k)
+    for (std::size_t j = 0; j < 21; ++j)
+      for (std::size_t i = 0; i < 21; ++i)
+        field(i, j, k) = { { 0.01 * static_cast<double>(j), 0.0, 0.2 } };
+  field(5, 10, 10)[0] += 2.0;
+  field(5, 11, 10)[0] -= 2.0;
+  field(17, 10, 10)[0] += 4.0;
+  field(17, 11, 10)[0] -= 4.0;
+  std::vector<std::uint8_t> outside(field.NumberOfVoxels(), 0);
+  std::size_t               foldedOutside{ 0 };
+  for (std::size_t k = 0; k < 21; ++k)
+    for (std::size_t j = 0; j < 21; ++j)
+      for (std::size_t i = 15; i < 21; ++i)
+      {
+        outside[field.Offset(i, j, k)] = 1;
+        foldedOutside += morea_core::JacobianDeterminantAt(field, i, j, k) <= 0.0;
+      }
+  ASSERT_GT(foldedOutside, 0u);
+  auto       plain = field;
+  const auto withMask = morea_core::RemoveVoxelFolds(field, {}, &outside);
+  const auto without = morea_core::RemoveVoxelFolds(plain);
+  EXPECT_EQ(field.data, plain.data) << "the mask only splits the report";
+  EXPECT_EQ(withMask.foldedBefore, without.foldedBefore);
+  EXPECT_GT(withMask.foldedBefore, foldedOutside) << "the spike the mesh covers folds too";
+  EXPECT_EQ(withMask.foldedBeforeOutsideMesh, foldedOutside);
+  EXPECT_EQ(without.foldedBeforeOutsideMesh, 0u);
+  EXPECT_DOUBLE_EQ(withMask.maximumChange, without.maximumChange);
+  EXPECT_GT(withMask.maximumChangeInsideMesh, 0.0);
+  EXPECT_LE(withMask.maximumChangeInsideMesh, 2.0 + 1e-9) << "the larger spike lies outside the mesh";
+  EXPECT_GT(withMask.maximumChange, withMask.maximumChangeInsideMesh);
+  EXPECT_DOUBLE_EQ(without.maximumChangeInsideMesh, without.maximumChange);
+
+  std::vector<std::uint8_t> wrongSize(3, 0);
+  EXPECT_THROW(morea_core::RemoveVoxelFolds(plain, {}, &wrongSize), morea_core::Error);
 }
 
 TEST(FieldFoldRepair, GivesUpAfterTheIterationLimitAndSaysSo)

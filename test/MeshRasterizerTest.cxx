@@ -133,6 +133,7 @@ TEST_F(MeshRasterizer, IdenticalMeshesGiveZeroField)
   morea_core::RasterizeDisplacement(topology, box.points, box.points, grid, &report);
   EXPECT_EQ(report.voxels, grid.NumberOfVoxels());
   EXPECT_EQ(report.outsideMesh, 0u);
+  EXPECT_TRUE(report.outsideMask.empty()) << "no mask when the mesh covers the grid";
   double largest = 0.0;
   for (const auto & u : grid.data)
     largest = std::max({ largest, std::abs(u[0]), std::abs(u[1]), std::abs(u[2]) });
@@ -238,6 +239,11 @@ TEST_F(MeshRasterizer, PartialMeshExtrapolatesAffinely)
   morea_core::RasterizationReport report;
   morea_core::RasterizeDisplacement(partialTopology, partial.points, MapPoints(partial.points, AffineImage), grid, &report);
   EXPECT_EQ(report.outsideMesh, (grid.size[0] - 20) * grid.size[1] * grid.size[2]);
+  ASSERT_EQ(report.outsideMask.size(), grid.NumberOfVoxels());
+  for (std::size_t k = 0; k < grid.size[2]; ++k)
+    for (std::size_t j = 0; j < grid.size[1]; ++j)
+      for (std::size_t i = 0; i < grid.size[0]; ++i)
+        ASSERT_EQ(report.outsideMask[grid.Offset(i, j, k)], i >= 20 ? 1 : 0) << i << "," << j << "," << k;
   double worst = 0.0;
   for (std::size_t k = 0; k < grid.size[2]; ++k)
     for (std::size_t j = 0; j < grid.size[1]; ++j)

@@ -16,6 +16,8 @@
 #include "morea_core/Volume.h"
 
 #include <cstddef>
+#include <cstdint>
+#include <vector>
 
 namespace morea_core
 {
@@ -48,6 +50,11 @@ struct FieldFoldRepairReport
   std::size_t  voxelsChanged{ 0 };  ///< voxels whose displacement was smoothed
   unsigned int iterations{ 0 };     ///< smoothing rounds run
   double       maximumChange{ 0.0 }; ///< largest |u_after - u_before| in mm
+  /** With an outside-the-mesh mask: the folded voxels on entry that the mesh
+   *  does not cover (its map extrapolated there), and the largest change
+   *  among the voxels it covers. */
+  std::size_t foldedBeforeOutsideMesh{ 0 };
+  double      maximumChangeInsideMesh{ 0.0 };
 };
 
 /** Removes voxel-level folds: while some voxel has a determinant <= 0, each
@@ -56,9 +63,12 @@ struct FieldFoldRepairReport
  *  updates of one round read the previous round's field). Voxels away from
  *  folds keep their exact values. Deterministic and single-threaded (the work
  *  is proportional to the folded region). Throws morea_core::Error on an empty
- *  field or a non-positive spacing. */
+ *  field or a non-positive spacing. `outsideMesh` (optional, one entry per
+ *  voxel, RasterizationReport::outsideMask) splits the report into voxels
+ *  the mesh covers and voxels it does not; it does not change the repair. */
 FieldFoldRepairReport
-RemoveVoxelFolds(Volume<Vec3> & field, const FieldFoldRepairOptions & options = {});
+RemoveVoxelFolds(Volume<Vec3> & field, const FieldFoldRepairOptions & options = {},
+                 const std::vector<std::uint8_t> * outsideMesh = nullptr);
 } // namespace morea_core
 
 #endif

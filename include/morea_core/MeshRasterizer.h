@@ -9,6 +9,7 @@
 #include "morea_core/Volume.h"
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 namespace morea_core
@@ -17,6 +18,9 @@ struct RasterizationReport
 {
   std::size_t voxels{ 0 };
   std::size_t outsideMesh{ 0 }; ///< voxels no tetrahedron of `from` contains (extrapolated)
+  /** Per voxel (offset order), 1 where no tetrahedron of `from` contains its
+   *  centre; filled only when `outsideMesh` > 0, else empty. */
+  std::vector<std::uint8_t> outsideMask;
 };
 
 /** Fills `field` (whose size, spacing and origin give the grid, in the domain

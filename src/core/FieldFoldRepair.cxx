@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace morea_core
@@ -103,10 +104,15 @@ CountNonPositiveJacobians(const Volume<Vec3> & field)
 }
 
 FieldFoldRepairReport
-RemoveVoxelFolds(Volume<Vec3> & field, const FieldFoldRepairOptions & options)
+RemoveVoxelFolds(Volume<Vec3> & field, const FieldFoldRepairOptions & options,
+                 const std::vector<std::uint8_t> * outsideMesh)
 {
   CheckField(field);
   const std::size_t n = field.NumberOfVoxels();
+  if (outsideMesh != nullptr && outsideMesh->size() != n)
+    throw Error("voxel fold repair: the outside-the-mesh mask has " + std::to_string(outsideMesh->size()) +
+                " entries for " + std::to_string(n) + " voxels");
+  auto isOutside = [&](std::size_t o) { return outsideMesh != nullptr && (*outsideMesh)[o] != 0; };
 
   auto isFolded = [&](std::size_t o) {
     const Index3 x = IndexOf(field, o);
@@ -120,6 +126,7 @@ RemoveVoxelFolds(Volume<Vec3> & field, const FieldFoldRepairOptions & options)
 
   FieldFoldRepairReport report;
   report.foldedBefore = folded.size();
+  report.foldedBeforeOutsideMesh = static_cast<std::size_t>(std::count_if(folded.begin(), folded.end(), isOutside));
   if (folded.empty())
     return report;
 
@@ -190,6 +197,8 @@ RemoveVoxelFolds(Volume<Vec3> & field, const FieldFoldRepairOptions & options)
     for (int c = 0; c < 3; ++c)
       squared += (field.data[o][c] - original[o][c]) * (field.data[o][c] - original[o][c]);
     report.maximumChange = std::max(report.maximumChange, std::sqrt(squared));
+    if (!isOutside(o))
+      report.maximumChangeInsideMesh = std::max(report.maximumChangeInsideMesh, std::sqrt(squared));
   }
   return report;
 }

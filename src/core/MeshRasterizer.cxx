@@ -304,7 +304,7 @@ RasterizeDisplacement(const MeshTopology & topology, const std::vector<Vec3> & f
   field.data.assign(voxels, Vec3{ { 0.0, 0.0, 0.0 } });
   if (report != nullptr)
   {
-    *report = RasterizationReport{ voxels, 0 };
+    *report = RasterizationReport{ voxels, 0, {} };
   }
   if (voxels == 0)
   {
@@ -347,6 +347,12 @@ RasterizeDisplacement(const MeshTopology & topology, const std::vector<Vec3> & f
   if (std::all_of(owner.begin(), owner.end(), [](std::uint32_t o) { return o == NoTetrahedron; }))
   {
     throw Error("mesh rasterisation: no voxel centre of the grid lies inside the mesh");
+  }
+  if (report != nullptr && std::find(owner.begin(), owner.end(), NoTetrahedron) != owner.end())
+  {
+    report->outsideMask.resize(voxels);
+    for (std::size_t o = 0; o < voxels; ++o)
+      report->outsideMask[o] = owner[o] == NoTetrahedron;
   }
   const std::size_t outside = ExtendOwnersOutsideMesh(field, owner);
   if (report != nullptr)

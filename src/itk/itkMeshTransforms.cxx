@@ -243,7 +243,8 @@ RasterizeSolution(const morea_core::MeshTopology & topology, const morea_core::D
                                      morea_core::Volume<morea_core::Vec3> volume) {
     Rasterized r{ std::move(volume), {}, {} };
     morea_core::RasterizeDisplacement(topology, from, to, r.volume, &r.report);
-    r.repair = morea_core::RemoveVoxelFolds(r.volume);
+    r.repair = morea_core::RemoveVoxelFolds(r.volume, {}, r.report.outsideMask.empty() ? nullptr : &r.report.outsideMask);
+    r.report.outsideMask = {}; // only needed to split the repair's report
     return r;
   };
   // ... and as a physical displacement field on the grid's full geometry.

@@ -313,14 +313,17 @@ WriteOutputFiles(const MultiObjectiveRegistrationRun & run, const morea_core::Pa
                              { "magnitude", s.fitness.objectives[0] },
                              { "intensity", s.fitness.objectives[1] },
                              { "guidance", s.fitness.objectives[2] } };
-    auto repairJson = [](const morea_core::FieldFoldRepairReport & r) {
+    auto repairJson = [](const morea_core::FieldFoldRepairReport & r, const morea_core::RasterizationReport & raster) {
       return nlohmann::json{ { "folded_voxels_before", r.foldedBefore },
                              { "folded_voxels_after", r.foldedAfter },
                              { "voxels_smoothed", r.voxelsChanged },
-                             { "maximum_change_mm", r.maximumChange } };
+                             { "maximum_change_mm", r.maximumChange },
+                             { "voxels_outside_mesh", raster.outsideMesh },
+                             { "folded_voxels_before_outside_mesh", r.foldedBeforeOutsideMesh },
+                             { "maximum_change_inside_mesh_mm", r.maximumChangeInsideMesh } };
     };
-    entry["voxel_fold_repair"] = { { "fixed_to_moving", repairJson(fields.fixedFoldRepair) },
-                                   { "moving_to_fixed", repairJson(fields.movingFoldRepair) } };
+    entry["voxel_fold_repair"] = { { "fixed_to_moving", repairJson(fields.fixedFoldRepair, fields.fixedReport) },
+                                   { "moving_to_fixed", repairJson(fields.movingFoldRepair, fields.movingReport) } };
     if (scored)
     {
       baseline.wait();
