@@ -12,7 +12,8 @@
 #   bench/run-cohort-benchmark.sh device-carry/bundle.tar.xz [N] [PARAMETERS.toml]
 # Results: $RESULTS (default ./cohort-benchmark). DEADLINE=S stops the
 # one-GPU cohort S seconds after the start (its finished registrations are kept).
-# SAMPLE_MS=0 turns the nvidia-smi sampling (every 500 ms) off.
+# SAMPLE_MS=0 turns the nvidia-smi sampling (every 500 ms) off;
+# CHECKPOINT_EVERY=N sets the batch's --checkpoint-every (default 10).
 # RUNS="all-gpus" or RUNS="one-gpu" runs one of the two cohorts (default both),
 # for a lease whose command time limit is shorter than both together; the
 # ratio is then the two calls' wall times, on the same machine while it is held.
@@ -46,7 +47,8 @@ run() { # NAME GPUS [TIMEOUT]
   (sleep 45; echo "== nvidia-smi 45 s into $name"; nvidia-smi) > "$out/$name-nvidia-smi.txt" 2>&1 &
   local snap=$!
   ${3:+timeout --signal=INT $3} $b/bin/python3 -m morea.cohort "$work/cohort.csv" -o "$work/$name" --gpus "$2" \
-    --parameters "$parameters" --var experiment_descriptor=cohort --morea $b/bin/morea --no-plots 2>&1 |
+    --parameters "$parameters" --var experiment_descriptor=cohort --morea $b/bin/morea --no-plots \
+    ${CHECKPOINT_EVERY:+--checkpoint-every $CHECKPOINT_EVERY} 2>&1 |
     tee "$out/$name.log"
   end=$(date +%s%N)
   kill $snap 2>/dev/null
@@ -54,6 +56,7 @@ run() { # NAME GPUS [TIMEOUT]
     tee -a "$out/times.txt"
   cp "$work/$name/registrations.csv" "$out/$name-registrations.csv" 2>/dev/null
   cp "$work/$name/cohort_summary.csv" "$out/$name-summary.csv" 2>/dev/null
+  grep -h "^times:" "$work/$name"/logs/*.log > "$out/$name-times.txt" 2>/dev/null
   cat "$out/$name-nvidia-smi.txt"
 }
 
@@ -63,7 +66,6 @@ left=""
 if [ -n "${DEADLINE:-}" ]; then left=$(( DEADLINE - ($(date +%s) - t0) )); fi
 case " $runs " in *" one-gpu "*) run one-gpu 0 $left ;; esac
 [ -n "$smi" ] && kill $smi 2>/dev/null
-grep -h "^times:" "$work"/one-gpu/logs/*.log > "$out/one-gpu-times.txt" 2>/dev/null
 $b/bin/python3 - "$out/times.txt" <<'EOF'
 import re, sys
 t = {m.group(1): int(m.group(2)) for m in re.finditer(r"(\S+): (\d+) ms", open(sys.argv[1]).read())}
