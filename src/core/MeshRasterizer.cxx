@@ -217,9 +217,11 @@ MarkTetrahedron(const TetrahedronMap & m, std::uint32_t index, const Volume<Vec3
 }
 
 /** Gives every unowned voxel the owner of the nearest owned voxel (breadth-first
- *  over 6-neighbours, sequential and in a fixed order, so deterministic). */
+ *  over 6-neighbours, sequential and in a fixed order, so deterministic);
+ *  marks the unowned voxels in `outsideMask` (when given) if there are any. */
 std::size_t
-ExtendOwnersOutsideMesh(const Volume<Vec3> & grid, std::vector<std::uint32_t> & owner)
+ExtendOwnersOutsideMesh(const Volume<Vec3> & grid, std::vector<std::uint32_t> & owner,
+                        std::vector<std::uint8_t> * outsideMask)
 {
   const std::size_t        nx = grid.size[0];
   const std::size_t        ny = grid.size[1];
@@ -250,6 +252,12 @@ ExtendOwnersOutsideMesh(const Volume<Vec3> & grid, std::vector<std::uint32_t> & 
     if (owner[o] == NoTetrahedron)
     {
       ++outside;
+      if (outsideMask != nullptr)
+      {
+        if (outsideMask->empty())
+          outsideMask->assign(count, 0);
+        (*outsideMask)[o] = 1;
+      }
       continue;
     }
     bool border = false;
@@ -348,13 +356,8 @@ RasterizeDisplacement(const MeshTopology & topology, const std::vector<Vec3> & f
   {
     throw Error("mesh rasterisation: no voxel centre of the grid lies inside the mesh");
   }
-  if (report != nullptr && std::find(owner.begin(), owner.end(), NoTetrahedron) != owner.end())
-  {
-    report->outsideMask.resize(voxels);
-    for (std::size_t o = 0; o < voxels; ++o)
-      report->outsideMask[o] = owner[o] == NoTetrahedron;
-  }
-  const std::size_t outside = ExtendOwnersOutsideMesh(field, owner);
+  const std::size_t outside =
+    ExtendOwnersOutsideMesh(field, owner, report != nullptr ? &report->outsideMask : nullptr);
   if (report != nullptr)
   {
     report->outsideMesh = outside;
