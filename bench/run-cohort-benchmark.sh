@@ -13,7 +13,8 @@
 # Results: $RESULTS (default ./cohort-benchmark). DEADLINE=S stops the
 # one-GPU cohort S seconds after the start (its finished registrations are kept).
 # SAMPLE_MS=0 turns the nvidia-smi sampling (every 500 ms) off;
-# CHECKPOINT_EVERY=N sets the batch's --checkpoint-every (default 10).
+# CHECKPOINT_EVERY=N|Ns sets the batch's --checkpoint-every (default: the
+# batch's, 30s; 0: only after the last generation).
 # RUNS="all-gpus" or RUNS="one-gpu" runs one of the two cohorts (default both),
 # for a lease whose command time limit is shorter than both together; the
 # ratio is then the two calls' wall times, on the same machine while it is held.

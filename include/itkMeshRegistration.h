@@ -33,9 +33,11 @@ namespace morea
 struct MeshRegistrationOptions
 {
   /** Checkpoint file; empty: none. Written every `checkpointInterval`
-   *  generations and after the last one. */
+   *  generations, at the first generation that ends `checkpointSeconds` or
+   *  more after the last checkpoint (0: neither), and after the last one. */
   std::string checkpointPath;
   std::size_t checkpointInterval{ 0 };
+  double      checkpointSeconds{ 0.0 };
   /** Continue from `checkpointPath` when it exists. */
   bool        resume{ false };
   std::size_t threads{ 0 }; ///< CPU backend threads (CUDA: host threads packing batches); 0: all

@@ -236,6 +236,11 @@ public:
   /** Write the checkpoint every this many generations (and after the last); 0: only after the last. */
   itkSetMacro(CheckpointInterval, SizeValueType);
   itkGetConstMacro(CheckpointInterval, SizeValueType);
+  /** Also write it at the first generation that ends this many seconds or
+   *  more after the last checkpoint (0, the default: off). On the GPU a
+   *  count of generations can mean a file a second; a duration does not. */
+  itkSetClampMacro(CheckpointSeconds, double, 0.0, NumericTraits<double>::max());
+  itkGetConstMacro(CheckpointSeconds, double);
   /** Continue from the checkpoint file when it exists. Generations restored
    *  from it fire no IterationEvent. */
   itkSetMacro(Resume, bool);
@@ -417,6 +422,7 @@ private:
   std::string                       m_RefusalBounds{ "auto" };
   std::string                       m_CheckpointFile{};
   SizeValueType                     m_CheckpointInterval{ 0 };
+  double                            m_CheckpointSeconds{ 0.0 };
   bool                              m_Resume{ false };
   std::string                       m_Selection{ "best-guidance" };
   std::vector<std::string>          m_StructureNames{};

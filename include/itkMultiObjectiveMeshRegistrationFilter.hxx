@@ -522,6 +522,7 @@ MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::GenerateData()
     morea::MeshRegistrationOptions options;
     options.checkpointPath = m_CheckpointFile;
     options.checkpointInterval = m_CheckpointInterval;
+    options.checkpointSeconds = m_CheckpointSeconds;
     options.resume = m_Resume;
     // Host threads: the work units, but no more than the threader's threads
     // (ITK's default work units are 4 per thread; the optimiser's pool wants
@@ -790,6 +791,7 @@ MultiObjectiveMeshRegistrationFilter<TFixedImage, TMovingImage>::PrintSelf(std::
   os << indent << "BackendNote: " << this->GetBackendNote() << std::endl;
   os << indent << "CheckpointFile: " << m_CheckpointFile << std::endl;
   os << indent << "CheckpointInterval: " << m_CheckpointInterval << std::endl;
+  os << indent << "CheckpointSeconds: " << m_CheckpointSeconds << std::endl;
   os << indent << "Resume: " << (m_Resume ? "On" : "Off") << std::endl;
   os << indent << "Parameters (the main keys and those set):" << std::endl;
   morea::PrintParameters(os, m_Parameters, indent.GetNextIndent());

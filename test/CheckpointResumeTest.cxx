@@ -124,6 +124,31 @@ TEST(CheckpointResume, OtherParametersOrImagesAreRefusedNamingTheKey)
   EXPECT_EQ(resumed.history.size(), 4u);
 }
 
+TEST(CheckpointResume, ADurationWritesNoCheckpointBeforeItHasPassedAndOneAfter)
+{
+  SmallRun                 run;
+  morea_core::ParameterSet p = run.parameters;
+  p.SetFromString("ea_num_generations", "5");
+  const auto stoppedAfter = [&](double seconds) {
+    std::filesystem::remove(run.checkpoint);
+    MeshRegistrationOptions options;
+    options.checkpointPath = run.checkpoint;
+    options.checkpointSeconds = seconds; // and no count of generations
+    options.resume = true;
+    options.backend = morea_core::BackendChoice::Cpu;
+    options.threads = 2;
+    options.onGeneration = [](const morea_core::GenerationRecord & record, std::size_t) {
+      if (record.generation == 3)
+        throw std::runtime_error("stopped");
+    };
+    EXPECT_THROW(RegisterMeshes(run.problem, p, options), std::runtime_error);
+    options.onGeneration = {};
+    return RegisterMeshes(run.problem, p, options).resumedAtGeneration;
+  };
+  EXPECT_EQ(stoppedAfter(3600.0), 0u); // an hour had not passed: nothing to resume from
+  EXPECT_EQ(stoppedAfter(1e-9), 3u);   // passed at every generation's end
+}
+
 /** Two mesh levels, two generations on the first, on the CPU with 2 threads. */
 morea_core::ParameterSet
 TwoLevels(const morea_core::ParameterSet & base, const std::string & generations, const std::string & refinement)

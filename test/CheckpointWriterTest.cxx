@@ -70,3 +70,36 @@ TEST(CheckpointWriter, ErrorsReachTheCallerOnce)
   EXPECT_FALSE(std::filesystem::exists(missing.parent_path()));
 }
 } // namespace
+
+TEST(CheckpointSchedule, ReadsGenerationsAndDurations)
+{
+  EXPECT_EQ(CheckpointSchedule::Parse("10").generations, 10u);
+  EXPECT_EQ(CheckpointSchedule::Parse("10").seconds, 0.0);
+  EXPECT_EQ(CheckpointSchedule::Parse("30s").seconds, 30.0);
+  EXPECT_EQ(CheckpointSchedule::Parse("30s").generations, 0u);
+  EXPECT_EQ(CheckpointSchedule::Parse("2.5min").seconds, 150.0);
+  EXPECT_EQ(CheckpointSchedule::Parse("0.5s").seconds, 0.5);
+  const CheckpointSchedule end = CheckpointSchedule::Parse("0");
+  EXPECT_EQ(end.generations, 0u);
+  EXPECT_EQ(end.seconds, 0.0);
+  EXPECT_EQ(end.Text(), "only after the last generation");
+  EXPECT_EQ(CheckpointSchedule::Parse("30s").Text(), "every 30 s");
+  for (const char * bad : { "", "s", "-1", "1.5", "10 s", "10h", "nan", "inf", "1e3s", "ten", "+5", " 5" })
+    EXPECT_THROW(CheckpointSchedule::Parse(bad), Error) << "'" << bad << "'";
+}
+
+TEST(CheckpointSchedule, IsDueEveryCountOfGenerationsOrOnceTheDurationHasPassed)
+{
+  const CheckpointSchedule byCount{ 10, 0.0 };
+  EXPECT_TRUE(byCount.Due(20, 0.0));
+  EXPECT_FALSE(byCount.Due(21, 1e6)); // time does not matter to a count
+  const CheckpointSchedule byTime{ 0, 30.0 };
+  EXPECT_FALSE(byTime.Due(20, 29.9)); // nor the generation to a duration
+  EXPECT_TRUE(byTime.Due(21, 30.0));
+  const CheckpointSchedule never{ 0, 0.0 };
+  EXPECT_FALSE(never.Due(10, 1e6));
+  const CheckpointSchedule both{ 10, 30.0 };
+  EXPECT_TRUE(both.Due(10, 0.0));
+  EXPECT_TRUE(both.Due(11, 31.0));
+  EXPECT_FALSE(both.Due(11, 1.0));
+}

@@ -11,12 +11,42 @@
 #ifndef morea_CheckpointWriter_h
 #define morea_CheckpointWriter_h
 
+#include <cstddef>
 #include <exception>
 #include <string>
 #include <thread>
 
 namespace morea_core
 {
+/** When checkpoints are written during a run (always after its last
+ *  generation as well): every `generations` generations, and at the first
+ *  generation that ends at least `seconds` after the last checkpoint (or the
+ *  run's start); 0 turns either off. On the GPU a generation of the paper's
+ *  configuration takes about 0.1 s, so a count of generations writes a 50 MB
+ *  file every second; a duration keeps the cost the same on every backend. */
+struct CheckpointSchedule
+{
+  std::size_t generations{ 0 };
+  double      seconds{ 0.0 };
+
+  /** "N" (generations), "Ns" or "Nmin" (a duration; N may have a fraction);
+   *  "0": only after the last generation. Throws Error on anything else. */
+  static CheckpointSchedule
+  Parse(const std::string & text);
+
+  /** Whether a checkpoint is due after `generation`, `secondsSinceLast`
+   *  after the last one. */
+  bool
+  Due(std::size_t generation, double secondsSinceLast) const
+  {
+    return (generations > 0 && generation % generations == 0) || (seconds > 0.0 && secondsSinceLast >= seconds);
+  }
+
+  /** For logs: "every 10 generations", "every 30 s", "only after the last generation". */
+  std::string
+  Text() const;
+};
+
 /** Writes `bytes` to `path` atomically: to `path.partial`, synced (fsync),
  *  then renamed and the folder synced, so
  *  that `path` holds either the old or the new file, never half of one.

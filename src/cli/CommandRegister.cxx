@@ -10,6 +10,7 @@
 
 #include "itkMOREAImageIO.h"
 #include "itkRegistrationOutputs.h"
+#include "morea_core/CheckpointWriter.h"
 #include "morea_core/ComputeDevices.h"
 #include "morea_core/OutputFolderLock.h"
 
@@ -30,7 +31,7 @@ struct Options
   ParameterOptions           parameters;
   std::string                output;
   std::string                select{ "best-guidance,knee" };
-  std::size_t                checkpointEvery{ 10 };
+  std::string                checkpointEvery{ "30s" };
   bool                       resume{ false };
   std::size_t                threads{ 0 };
   std::string                backend{ "auto" };
@@ -66,7 +67,9 @@ RegisterOnce(const itk::morea::RegistrationProblem & input, const ParameterSet &
   settings.refusalBounds = options.refusalBound;
   settings.selection = options.select;
   settings.checkpointFile = folder + "/checkpoint.bin";
-  settings.checkpointInterval = options.checkpointEvery;
+  const auto schedule = morea_core::CheckpointSchedule::Parse(options.checkpointEvery);
+  settings.checkpointInterval = schedule.generations;
+  settings.checkpointSeconds = schedule.seconds;
   settings.resume = options.resume;
   settings.initialTransform = initialTransform;
   settings.onGeneration = [print = ProgressPrinter(), killAfter = options.killAfter](
@@ -148,7 +151,21 @@ AddRegisterCommand(CLI::App & app)
                   "solutions to write: best-guidance, knee, weighted:a:b:c, nearest:m:i:g, all (comma-separated)")
     ->capture_default_str();
   cmd->add_option("--checkpoint-every", options->checkpointEvery,
-                  "write output/checkpoint.bin every N generations (0: only at the end)")
+                  "write output/checkpoint.bin every N generations (10), every so long (30s, 5min: at the first "
+                  "generation that ends that long after the last checkpoint), or 0: only at the end")
+    ->check(
+      [](const std::string & text) {
+        try
+        {
+          morea_core::CheckpointSchedule::Parse(text);
+          return std::string();
+        }
+        catch (const std::exception & e)
+        {
+          return std::string(e.what());
+        }
+      },
+      "N, Ns, Nmin")
     ->capture_default_str();
   cmd->add_flag("--resume", options->resume, "continue from output/checkpoint.bin when it exists");
   cmd->add_option("--threads", options->threads, "host threads (0: all)")->capture_default_str();

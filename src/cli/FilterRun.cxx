@@ -65,6 +65,7 @@ MakeRegistrationFilter(const itk::morea::RegistrationProblem & problem, const Pa
   filter->SetSelection(settings.selection);
   filter->SetCheckpointFile(settings.checkpointFile);
   filter->SetCheckpointInterval(settings.checkpointInterval);
+  filter->SetCheckpointSeconds(settings.checkpointSeconds);
   filter->SetResume(settings.resume);
   filter->SetInitialMovingTransform(settings.initialTransform);
   if (settings.onGeneration)

@@ -24,7 +24,8 @@ struct FilterSettings
   std::string refusalBounds{ "auto" };
   std::string selection{ "best-guidance,knee" };
   std::string checkpointFile; ///< empty: none
-  std::size_t checkpointInterval{ 0 };
+  std::size_t checkpointInterval{ 0 }; ///< generations; 0: none
+  double      checkpointSeconds{ 0.0 }; ///< 0: none
   bool        resume{ false };
   /** Pre-alignment given instead of the rigid step; null: none. */
   RegistrationFilterType::InitialTransformType::ConstPointer initialTransform;

@@ -4,10 +4,13 @@
 
 #include "morea_core/Error.h"
 
+#include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <system_error>
 #include <utility>
 
@@ -75,6 +78,57 @@ SyncFolderOf(const std::string & path)
 }
 } // namespace
 #endif
+
+CheckpointSchedule
+CheckpointSchedule::Parse(const std::string & text)
+{
+  const auto bad = [&text] {
+    return Error("checkpoint interval '" + text +
+                 "': expected a number of generations (10), a duration (30s, 2.5min) or 0 (only at the end)");
+  };
+  std::size_t  used = 0;
+  double       value = 0.0;
+  try
+  {
+    value = std::stod(text, &used);
+  }
+  catch (const std::exception &)
+  {
+    throw bad();
+  }
+  const std::string number = text.substr(0, used), unit = text.substr(used);
+  // Digits with at most one point: no sign, exponent, spaces, hex or inf.
+  if (number.find_first_not_of("0123456789.") != std::string::npos || number.find('.') != number.rfind('.') ||
+      !std::isdigit(static_cast<unsigned char>(number[0])) || !std::isfinite(value))
+    throw bad();
+  CheckpointSchedule schedule;
+  if (unit.empty())
+  {
+    if (value != std::floor(value) || value > 1e15)
+      throw bad();
+    schedule.generations = static_cast<std::size_t>(value);
+  }
+  else if (unit == "s")
+    schedule.seconds = value;
+  else if (unit == "min")
+    schedule.seconds = 60.0 * value;
+  else
+    throw bad();
+  return schedule;
+}
+
+std::string
+CheckpointSchedule::Text() const
+{
+  std::ostringstream out;
+  if (generations > 0)
+    out << "every " << generations << " generations";
+  if (seconds > 0.0)
+    out << (generations > 0 ? " or " : "every ") << seconds << " s";
+  if (generations == 0 && seconds <= 0.0)
+    out << "only after the last generation";
+  return out.str();
+}
 
 void
 WriteFileAtomically(const std::string & path, const std::string & bytes)

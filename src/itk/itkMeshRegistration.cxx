@@ -176,6 +176,8 @@ RegisterMeshes(const RegistrationProblem & problem, const morea_core::ParameterS
     baseOptions.fingerprint.Add(key, value);
 
   morea_core::CheckpointWriter checkpoints; // files written while the next generations run
+  const morea_core::CheckpointSchedule checkpointSchedule{ options.checkpointInterval, options.checkpointSeconds };
+  auto                         lastCheckpoint = Clock::now(); // or the optimisation's start
   std::size_t               checkpointGeneration = 0; // of the last checkpoint written; 0: none
   std::string               checkpointPath = options.checkpointPath;
   std::size_t               generation = 0;
@@ -244,8 +246,10 @@ RegisterMeshes(const RegistrationProblem & problem, const morea_core::ParameterS
         generation = optimiser.Generation();
         const bool last = optimiser.Finished();
         if (!checkpointPath.empty() &&
-            (last || (options.checkpointInterval > 0 && optimiser.Generation() % options.checkpointInterval == 0)))
+            (last || checkpointSchedule.Due(optimiser.Generation(),
+                                            std::chrono::duration<double>(Clock::now() - lastCheckpoint).count())))
         {
+          lastCheckpoint = Clock::now();
           std::string bytes = checkpoints.TakeBuffer(); // the last checkpoint's room
           optimiser.CheckpointBytes(bytes);
           checkpoints.Write(std::move(bytes), checkpointPath);

@@ -61,7 +61,7 @@ def _progress_bar(enabled):
 
 
 def register(fixed, moving, structures=None, points=None, landmarks=None, parameters=None, backend="auto",
-             select="best-guidance,knee", seed=None, checkpoint=None, checkpoint_every=10, resume=False,
+             select="best-guidance,knee", seed=None, checkpoint=None, checkpoint_every="30s", resume=False,
              initial_transform=None, progress=True, callback=None):
     """Registers `moving` onto `fixed` with MOREA; returns a RegistrationResult.
 
@@ -74,6 +74,9 @@ def register(fixed, moving, structures=None, points=None, landmarks=None, parame
     select: the solutions to rasterise at once (best-guidance, knee,
         weighted:a:b:c, nearest:m:i:g, all; comma-separated); any other later
         with result.choose().
+    checkpoint: a file to write the optimiser's state to, every
+        `checkpoint_every`: a number of generations (10) or a duration ("30s",
+        "5min"); `resume` continues from it when it exists.
     initial_transform: a SimpleITK or itk linear transform (fixed -> moving points) used
         instead of the rigid pre-alignment.
     callback: called as callback(generation, total, front_size, best_guidance)
@@ -87,7 +90,7 @@ def register(fixed, moving, structures=None, points=None, landmarks=None, parame
     registration.set_backend(backend)
     registration.set_selection(select)
     if checkpoint is not None:
-        registration.set_checkpoint(os.fspath(checkpoint), int(checkpoint_every), bool(resume))
+        registration.set_checkpoint(os.fspath(checkpoint), str(checkpoint_every), bool(resume))
     bar = _progress_bar(progress)
 
     def on_generation(generation, total, front, best_guidance):

@@ -117,7 +117,7 @@ def finished_record(registration, status):
             "seconds_optimisation": seconds.get("optimisation", "")}
 
 
-def run_registration(registration, morea, log_folder, threads=0, checkpoint_every=10):
+def run_registration(registration, morea, log_folder, threads=0, checkpoint_every="30s"):
     """Runs one registration with `morea register` and returns its record.
     An earlier attempt's checkpoint (its worker died) is resumed; a folder
     with a complete result is not touched."""
@@ -136,7 +136,7 @@ def run_registration(registration, morea, log_folder, threads=0, checkpoint_ever
                 "error": f"the output folder {registration.output} stays locked by another process"}
     threads = int(threads) or available_cores()
     command = [morea, "register", *registration.arguments, "-o", registration.output, "--resume",
-               "--checkpoint-every", str(int(checkpoint_every)), "--threads", str(threads),
+               "--checkpoint-every", str(checkpoint_every), "--threads", str(threads),
                "--set", "num_runs=1", "--set", "zip=false"]
     os.makedirs(log_folder, exist_ok=True)
     log_path = os.path.join(log_folder, registration.id + ".log")

@@ -19,6 +19,7 @@ import argparse
 import ast
 import logging
 import os
+import re
 import shutil
 import socket
 import subprocess
@@ -273,7 +274,7 @@ def _threads(client, given):
 
 def batch(cohort, output=None, cluster="local", scheduler=None, workers=None, gpus=None, jobs=None,
           cluster_options=None, threads=None, parameters=None, overrides=None, variables=None, seed=None,
-          backend=None, select=None, checkpoint_every=10, morea=None, progress=True, plots=True):
+          backend=None, select=None, checkpoint_every="30s", morea=None, progress=True, plots=True):
     """Runs a cohort of registrations on Dask; returns a BatchResult.
 
     cohort: a CSV file (one registration per row) or a list of dicts with
@@ -293,11 +294,16 @@ def batch(cohort, output=None, cluster="local", scheduler=None, workers=None, gp
         backend, select: for every row, which a row's columns override.
     threads: host threads per registration (default: the machine's cores
         shared by its workers).
-    checkpoint_every: generations between checkpoints (a killed worker's
-        registration resumes from the last one).
+    checkpoint_every: how often each registration writes its checkpoint (a
+        killed worker's registration resumes from the last one): a number of
+        generations (10) or a duration ("30s", "5min"; on the GPU ten
+        generations take about a second).
     morea: the `morea` executable (default: $MOREA_BIN, or on the PATH).
     """
     started = time.time()
+    if not re.fullmatch(r"\d+|\d+(\.\d*)?(s|min)", str(checkpoint_every)):  # as morea register reads it
+        raise ValueError(f"checkpoint_every '{checkpoint_every}': expected a number of generations (10), "
+                         "a duration (30s, 2.5min) or 0 (only at the end)")
     morea = find_morea(morea)
     if output is None:
         if isinstance(cohort, (str, os.PathLike)):
@@ -402,24 +408,44 @@ def _run(client, pending, records, morea, logs, threads, checkpoint_every, show,
     per_registration = _threads(client, threads)
     progress = _Progress(len(pending), len(records), len(info), show, os.path.join(output, "status.json"))
     client.subscribe_topic(EVENT_TOPIC, progress.event)
+    # Registrations go out as workers have room, not all at once: Dask hands
+    # resource-bound tasks to workers when they are submitted, so a worker
+    # that finished early would otherwise wait while another still had two.
+    waiting = list(pending)
     futures = {}
-    for r in pending:
-        future = client.submit(run_registration, r, morea, logs, per_registration, checkpoint_every,
-                               key=f"morea-register-{r.id}-{os.getpid()}-{int(time.time() * 1000)}", pure=False,
-                               resources={RESOURCE: 1} if with_resource else None)
-        futures[future] = r
+    completed = as_completed()
+    lock = threading.Lock()
+
+    def submit_more():
+        with lock:
+            room = _slots(client, with_resource) - len(futures)
+            while waiting and room > 0:
+                r = waiting.pop(0)
+                future = client.submit(run_registration, r, morea, logs, per_registration, checkpoint_every,
+                                       key=f"morea-register-{r.id}-{os.getpid()}-{int(time.time() * 1000)}",
+                                       pure=False, resources={RESOURCE: 1} if with_resource else None)
+                futures[future] = r
+                completed.add(future)
+                room -= 1
+
+    submit_more()
     progress.report(force=True)
     stop = threading.Event()
 
-    def tick():
+    def tick():  # also gives workers that joined since (a Slurm job that started) their registrations
         while not stop.wait(5.0):
             progress.report()
+            try:
+                submit_more()
+            except Exception:  # the scheduler is going away; the main loop says why
+                pass
 
     ticker = threading.Thread(target=tick, daemon=True)
     ticker.start()
     try:
-        for future in as_completed(futures):
-            r = futures[future]
+        for future in completed:
+            with lock:
+                r = futures.pop(future)
             try:
                 record = future.result()
             except Exception as e:  # the worker died too often (KilledWorker), or the task itself broke
@@ -428,6 +454,7 @@ def _run(client, pending, records, morea, logs, threads, checkpoint_every, show,
             records[r.id] = record
             progress.done(record)
             progress.report(force=record["status"] == "failed")
+            submit_more()
     finally:
         stop.set()
         ticker.join()
@@ -435,6 +462,17 @@ def _run(client, pending, records, morea, logs, threads, checkpoint_every, show,
             client.unsubscribe_topic(EVENT_TOPIC)
         except Exception:
             pass
+
+
+def _slots(client, with_resource):
+    """Registrations the workers can run at once: their GPUs (the resource),
+    else their threads; at least one, so that a batch waits for workers."""
+    workers = client.scheduler_info()["workers"].values()
+    if with_resource:
+        count = sum(int(w.get("resources", {}).get(RESOURCE, 0)) for w in workers)
+    else:
+        count = sum(int(w.get("nthreads", 1)) for w in workers)
+    return max(1, count)
 
 
 def _option_value(text):
@@ -470,7 +508,8 @@ def main(argv=None, morea=None):
     parser.add_argument("--seed", type=int, help="seed for rows without their own")
     parser.add_argument("--backend", help="auto, cuda, cuda-exact or cpu for rows without their own")
     parser.add_argument("--select", help="solutions to write, for rows without their own")
-    parser.add_argument("--checkpoint-every", type=int, default=10, help="generations between checkpoints")
+    parser.add_argument("--checkpoint-every", default="30s",
+                        help="each registration's checkpoints: every N generations (10) or so long (30s, 5min)")
     parser.add_argument("--no-plots", action="store_true", help="no score plots")
     parser.add_argument("--quiet", action="store_true", help="no progress lines")
     parser.add_argument("--morea", default=morea, help="the morea executable the workers run")

@@ -14,6 +14,7 @@
 #include "itkRegistrationOutputs.h"
 #include "itkRegistrationPlots.h"
 #include "itkRegistrationRunFolder.h"
+#include "morea_core/CheckpointWriter.h"
 #include "morea_core/Error.h"
 #include "morea_core/OutputFolderLock.h"
 
@@ -327,10 +328,12 @@ public:
     Call([&] { m_Filter->SetSelection(selection); });
   }
   void
-  SetCheckpoint(const std::string & path, std::size_t interval, bool resume)
+  SetCheckpoint(const std::string & path, const std::string & every, bool resume)
   {
+    const auto schedule = UserCall([&] { return morea_core::CheckpointSchedule::Parse(every); }); // before any is set
     m_Filter->SetCheckpointFile(path);
-    m_Filter->SetCheckpointInterval(interval);
+    m_Filter->SetCheckpointInterval(schedule.generations);
+    m_Filter->SetCheckpointSeconds(schedule.seconds);
     m_Filter->SetResume(resume);
   }
 

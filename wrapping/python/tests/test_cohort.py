@@ -108,7 +108,9 @@ def test_table_errors_are_refused_before_anything_runs(problems, tmp_path):
     no_problem.write_text("id,fixed\na,pelvis/fixed.nii.gz\n")
     with pytest.raises(ValueError, match="row 2: give a problem folder"):
         morea.batch(str(no_problem), str(tmp_path / "c"), progress=False)
-    assert not (tmp_path / "a").exists() and not (tmp_path / "b").exists()
+    with pytest.raises(ValueError, match="checkpoint_every '10 generations'"):
+        morea.batch(str(twice), str(tmp_path / "e"), checkpoint_every="10 generations", progress=False)
+    assert not (tmp_path / "a").exists() and not (tmp_path / "b").exists() and not (tmp_path / "e").exists()
     # The command line says so and exits with 2.
     assert main([str(twice), "-o", str(tmp_path / "d"), "--quiet"], morea=os.environ["MOREA_BIN"]) == 2
 

@@ -105,6 +105,8 @@ def test_errors_are_python_exceptions(phantom):
                        parameters={**TINY, "preprocess_rigid_structure": "none"}, backend="cpu", progress=False)
     with pytest.raises(ValueError, match="empty"):
         morea.register(fixed, moving, points={"rectum": (np.zeros((0, 3)), None)}, progress=False)
+    with pytest.raises(ValueError, match=r"checkpoint interval '10h': expected a number of generations \(10\), a dur"):
+        morea.register(fixed, moving, checkpoint="never-written.bin", checkpoint_every="10h", progress=False)
     # A mask on another grid than its image, and a guidance structure that is not given.
     small = sitk.Image([5, 5, 5], sitk.sitkUInt8)
     with pytest.raises(RuntimeError, match="^structure 'bladder': the fixed mask is not on the image grid"):
