@@ -198,6 +198,22 @@ def test_a_killed_worker_s_registration_resumes_from_its_checkpoint_to_the_same_
     assert summaries[0]["generations"] == summaries[1]["generations"] == KILL_GENERATIONS
 
 
+def test_a_worker_that_finishes_early_takes_the_next_registration(problems, tmp_path):
+    # Two workers, one long registration and two short ones: the second short
+    # one waits for room and goes to the worker the first short one freed,
+    # not to a queue behind the long one.
+    pelvis = problems / "pelvis"
+    table = tmp_path / "cohort.csv"
+    table.write_text("id,problem,seed,set\n"
+                     f"long,{pelvis},1,ea_num_generations=80\nshort1,{pelvis},2,ea_num_generations=3\n"
+                     f"short2,{pelvis},3,ea_num_generations=3\n")
+    result = morea.batch(str(table), str(tmp_path / "out"), cluster="local-cpu", workers=2, threads=1,
+                         parameters=problems / "tiny.toml", backend="cpu", progress=False, plots=False)
+    records = {r["id"]: r for r in result.records}
+    assert [records[i]["status"] for i in ("long", "short1", "short2")] == ["finished"] * 3
+    assert records["short2"]["worker"] == records["short1"]["worker"] != records["long"]["worker"]
+
+
 def test_morea_batch_runs_the_python_package(problems, tmp_path):
     table = tmp_path / "cohort.csv"
     table.write_text(f"id,problem,seed,set\none,{problems / 'static-bones'},7,ea_num_generations=3\n")
