@@ -82,8 +82,6 @@ TEST(CheckpointSchedule, ReadsGenerationsAndDurations)
   const CheckpointSchedule end = CheckpointSchedule::Parse("0");
   EXPECT_EQ(end.generations, 0u);
   EXPECT_EQ(end.seconds, 0.0);
-  EXPECT_EQ(end.Text(), "only after the last generation");
-  EXPECT_EQ(CheckpointSchedule::Parse("30s").Text(), "every 30 s");
   for (const char * bad : { "", "s", "-1", "1.5", "10 s", "10h", "nan", "inf", "1e3s", "ten", "+5", " 5" })
     EXPECT_THROW(CheckpointSchedule::Parse(bad), Error) << "'" << bad << "'";
 }

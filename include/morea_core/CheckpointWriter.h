@@ -41,10 +41,6 @@ struct CheckpointSchedule
   {
     return (generations > 0 && generation % generations == 0) || (seconds > 0.0 && secondsSinceLast >= seconds);
   }
-
-  /** For logs: "every 10 generations", "every 30 s", "only after the last generation". */
-  std::string
-  Text() const;
 };
 
 /** Writes `bytes` to `path` atomically: to `path.partial`, synced (fsync),

@@ -10,7 +10,6 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <system_error>
 #include <utility>
 
@@ -115,19 +114,6 @@ CheckpointSchedule::Parse(const std::string & text)
   else
     throw bad();
   return schedule;
-}
-
-std::string
-CheckpointSchedule::Text() const
-{
-  std::ostringstream out;
-  if (generations > 0)
-    out << "every " << generations << " generations";
-  if (seconds > 0.0)
-    out << (generations > 0 ? " or " : "every ") << seconds << " s";
-  if (generations == 0 && seconds <= 0.0)
-    out << "only after the last generation";
-  return out.str();
 }
 
 void
