@@ -38,7 +38,7 @@ struct FieldFoldRepairOptions
   /** The smoothed neighbourhood of each folded voxel starts at this Chebyshev
    *  radius (voxels) and grows by one every `iterationsPerRadius` rounds...
    *  (A slow growth changes less: on the abdominal pair's folded fields 40
-   *  rounds per radius smoothed 16-30 % fewer voxels than 10, for one and a
+   *  rounds per radius smoothed 16-18 % fewer voxels than 10, for one and a
    *  half times the rounds; bench/results/generation-budget.md.) */
   unsigned int initialRadius{ 1 };
   unsigned int iterationsPerRadius{ 40 };
