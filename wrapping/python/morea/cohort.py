@@ -261,7 +261,7 @@ def _threads(client, given):
         return int(given)
     from urllib.parse import urlparse
 
-    hosts = [urlparse(address).hostname for address in client.scheduler_info()["workers"]]
+    hosts = [urlparse(address).hostname for address in _workers(client)]
     names = {"127.0.0.1", "localhost", "::1", socket.gethostname()}
     try:
         names.update(socket.gethostbyname_ex(socket.gethostname())[2])
@@ -399,7 +399,7 @@ def _run(client, pending, records, morea, logs, threads, checkpoint_every, show,
         client.wait_for_workers(1, timeout=600)
     except Exception:
         raise RuntimeError(f"no Dask worker joined within 10 minutes ({note})") from None
-    info = client.scheduler_info()["workers"]
+    info = _workers(client)
     with_resource = all(RESOURCE in w.get("resources", {}) for w in info.values())
     if not with_resource and show:
         print(f"batch: the workers do not all offer the resource '{RESOURCE}'; start them with "
@@ -464,10 +464,18 @@ def _run(client, pending, records, morea, logs, threads, checkpoint_every, show,
             pass
 
 
+def _workers(client):
+    """{address: info} of every worker (distributed 2025.x lists five unless asked for all)."""
+    try:
+        return client.scheduler_info(n_workers=-1)["workers"]
+    except TypeError:  # a distributed without n_workers lists them all
+        return client.scheduler_info()["workers"]
+
+
 def _slots(client, with_resource):
     """Registrations the workers can run at once: their GPUs (the resource),
     else their threads; at least one, so that a batch waits for workers."""
-    workers = client.scheduler_info()["workers"].values()
+    workers = _workers(client).values()
     if with_resource:
         count = sum(int(w.get("resources", {}).get(RESOURCE, 0)) for w in workers)
     else:
