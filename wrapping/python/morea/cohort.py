@@ -19,7 +19,6 @@ import argparse
 import ast
 import logging
 import os
-import re
 import shutil
 import socket
 import subprocess
@@ -30,6 +29,7 @@ import time
 from ._cohort_report import write_report, write_text
 from ._cohort_table import parse_cohort, read_rows
 from ._cohort_worker import EVENT_TOPIC, available_cores, finished_record, run_registration
+from ._morea import parse_checkpoint_every
 
 __all__ = ["batch", "BatchResult", "local_gpus", "make_cluster", "main"]
 
@@ -301,9 +301,11 @@ def batch(cohort, output=None, cluster="local", scheduler=None, workers=None, gp
     morea: the `morea` executable (default: $MOREA_BIN, or on the PATH).
     """
     started = time.time()
-    if not re.fullmatch(r"\d+|\d+(\.\d*)?(s|min)", str(checkpoint_every)):  # as morea register reads it
+    try:
+        parse_checkpoint_every(str(checkpoint_every))  # as morea register reads it
+    except ValueError:
         raise ValueError(f"checkpoint_every '{checkpoint_every}': expected a number of generations (10), "
-                         "a duration (30s, 2.5min) or 0 (only at the end)")
+                         "a duration (30s, 2.5min) or 0 (only at the end)") from None
     morea = find_morea(morea)
     if output is None:
         if isinstance(cohort, (str, os.PathLike)):

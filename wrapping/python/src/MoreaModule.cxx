@@ -783,6 +783,13 @@ PYBIND11_MODULE(_morea, m)
     .def_readwrite("origin", &Geometry::origin)
     .def_readwrite("direction", &Geometry::direction);
   m.def(
+    "parse_checkpoint_every",
+    [](const std::string & text) {
+      const auto schedule = UserCall([&] { return morea_core::CheckpointSchedule::Parse(text); });
+      return std::make_pair(schedule.generations, schedule.seconds);
+    },
+    py::arg("text"), "(generations, seconds) of a --checkpoint-every value; ValueError when it is none");
+  m.def(
     "phantom",
     [](double spacing, std::uint64_t seed) {
       morea_core::PhantomOptions options;
