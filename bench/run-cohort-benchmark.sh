@@ -12,7 +12,9 @@
 #   bench/run-cohort-benchmark.sh device-carry/bundle.tar.xz [N] [PARAMETERS.toml]
 # Results: $RESULTS (default ./cohort-benchmark). DEADLINE=S stops the
 # one-GPU cohort S seconds after the start (its finished registrations are kept).
-# SAMPLE_MS=0 turns the nvidia-smi sampling (every 500 ms) off;
+# SAMPLE_MS=N samples every GPU's utilisation every N ms (default 5000; 0:
+# off). Sampling every 500 ms slowed the two-GPU cohort by about 5 %
+# (bench/results/cohort-batch.md); the snapshot 45 s in is always taken;
 # CHECKPOINT_EVERY=N|Ns sets the batch's --checkpoint-every (default: the
 # batch's, 30s; 0: only after the last generation).
 # RUNS="all-gpus" or RUNS="one-gpu" runs one of the two cohorts (default both),
@@ -36,8 +38,8 @@ gpus=$(nvidia-smi --query-gpu=index --format=csv,noheader 2>/dev/null | paste -s
 gpus=${gpus:-0,1}
 echo "GPUs: $gpus; $(nproc) cores; bundle ready after $(( $(date +%s) - t0 )) s"
 smi=""
-if [ "${SAMPLE_MS:-500}" -gt 0 ]; then
-  nvidia-smi --query-gpu=timestamp,index,utilization.gpu,memory.used --format=csv,noheader -lms "${SAMPLE_MS:-500}" \
+if [ "${SAMPLE_MS:-5000}" -gt 0 ]; then
+  nvidia-smi --query-gpu=timestamp,index,utilization.gpu,memory.used --format=csv,noheader -lms "${SAMPLE_MS:-5000}" \
     > "$out/nvidia-smi.csv" 2>/dev/null &
   smi=$!
 fi
