@@ -57,12 +57,15 @@ def determinants_and_cofactors(u, h):
 def project(u0, h, target, step, rounds):
     u = u0.copy()
     weights = stencil_weights(u.shape[:3], h)
+    # Per index axis, the squared weights summed: how much a unit cofactor
+    # moves the determinant's stencil.
+    weight_norms = [sum(w[..., 0] ** 2 for w in axis_weights) for axis_weights in weights]
     for round_ in range(rounds):
         det, C = determinants_and_cofactors(u, h)
         if not (det <= 0).any():
             return u, round_
         shortfall = np.where(det < target, target - det, 0.0)
-        norm2 = sum((C[..., :, j] ** 2).sum(-1) * sum(w[..., 0] ** 2 for w in weights[j]) for j in range(3))
+        norm2 = sum((C[..., :, j] ** 2).sum(-1) * weight_norms[j] for j in range(3))
         share = np.where(shortfall > 0, shortfall / np.maximum(norm2, 1e-12), 0.0)[..., None]
         change = np.zeros_like(u)
         for j, axis in enumerate(AXES):
