@@ -116,7 +116,7 @@ struct MeshFields
   morea_core::RasterizationReport fixedReport;
   morea_core::RasterizationReport movingReport;
   /** Voxel-level fold repair of fixedToMoving and movingToFixed (see
-   *  morea/FieldFoldRepair.h): how many voxels were folded and smoothed. */
+   *  morea_core/FieldFoldRepair.h): how many voxels were folded and changed. */
   morea_core::FieldFoldRepairReport fixedFoldRepair;
   morea_core::FieldFoldRepairReport movingFoldRepair;
 };

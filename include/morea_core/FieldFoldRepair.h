@@ -9,7 +9,11 @@
 // tetrahedron meets a stretched neighbour: a central difference spans two
 // voxels and mixes the gradients of several tetrahedra. Users (and every
 // tool that scores registrations) measure folds on the voxel field, so the
-// field is smoothed locally around such voxels until none remain.
+// field is changed around such voxels until none remain: first by a
+// projection that moves each voxel as little as it can (on the abdominal
+// pair's folded fields at most 2.5-6.3 mm, where local smoothing moved
+// voxels by 50 mm; bench/results/generation-budget.md), and by local
+// smoothing only where the projection does not converge.
 #ifndef morea_FieldFoldRepair_h
 #define morea_FieldFoldRepair_h
 
@@ -33,7 +37,20 @@ CountNonPositiveJacobians(const Volume<Vec3> & field);
 
 struct FieldFoldRepairOptions
 {
-  /** Rounds of smoothing before giving up (the remaining folds are reported). */
+  /** The projection: each round, every voxel whose determinant is below
+   *  half of `projectionTarget` asks for the smallest change of the
+   *  displacements its determinant reads that lifts it, linearised, to the
+   *  target; the requests are summed and `projectionStep` of the sum
+   *  applied. It stops when no determinant is <= 0, or after
+   *  `maximumProjectionRounds` (0: smoothing only). */
+  double       projectionTarget{ 0.01 };
+  double       projectionStep{ 0.9 };
+  unsigned int maximumProjectionRounds{ 3000 };
+  /** Threads of the projection (0: one per hardware thread); the result
+   *  does not depend on them. */
+  std::size_t threads{ 0 };
+  /** The last resort, for folds the projection leaves: rounds of smoothing
+   *  before giving up (the remaining folds are reported). */
   unsigned int maximumIterations{ 400 };
   /** The smoothed neighbourhood of each folded voxel starts at this Chebyshev
    *  radius (voxels) and grows by one every `iterationsPerRadius` rounds...
@@ -49,9 +66,11 @@ struct FieldFoldRepairOptions
 struct FieldFoldRepairReport
 {
   std::size_t  foldedBefore{ 0 };   ///< voxels with determinant <= 0 on entry
-  std::size_t  foldedAfter{ 0 };    ///< ... on return (0 unless the iterations ran out)
-  std::size_t  voxelsChanged{ 0 };  ///< voxels whose displacement was smoothed
-  unsigned int iterations{ 0 };     ///< smoothing rounds run
+  std::size_t  foldedAfter{ 0 };    ///< ... on return (0 unless both repairs ran out of rounds)
+  std::size_t  voxelsChanged{ 0 };  ///< voxels whose displacement was changed
+  std::size_t  voxelsChangedOver1mm{ 0 }; ///< ... by more than 1 mm
+  unsigned int projectionRounds{ 0 };
+  unsigned int smoothingRounds{ 0 }; ///< 0 unless the projection left folds
   double       maximumChange{ 0.0 }; ///< largest |u_after - u_before| in mm
   /** With an outside-the-mesh mask: the folded voxels on entry that the mesh
    *  does not cover (its map extrapolated there), and the largest change
@@ -60,15 +79,17 @@ struct FieldFoldRepairReport
   double      maximumChangeInsideMesh{ 0.0 };
 };
 
-/** Removes voxel-level folds: while some voxel has a determinant <= 0, each
- *  voxel within the current radius of a folded voxel takes the mean
- *  displacement of its 3x3x3 neighbourhood (clipped at the grid's edge; all
- *  updates of one round read the previous round's field). Voxels away from
- *  folds keep their exact values. Deterministic and single-threaded (the work
- *  is proportional to the folded region). Throws morea_core::Error on an empty
- *  field or a non-positive spacing. `outsideMesh` (optional, one entry per
- *  voxel, RasterizationReport::outsideMask) splits the report into voxels
- *  the mesh covers and voxels it does not; it does not change the repair. */
+/** Removes voxel-level folds: the projection (see FieldFoldRepairOptions),
+ *  then, if folds remain, rounds in which each voxel within the current
+ *  radius of a folded voxel takes the mean displacement of its 3x3x3
+ *  neighbourhood (clipped at the grid's edge; all updates of one round read
+ *  the previous round's field). Voxels away from folds keep their exact
+ *  values. Deterministic (the work is proportional to the folded region; the
+ *  smoothing is single-threaded). Throws morea_core::Error on an empty field, a
+ *  non-positive spacing or a projection target <= 0 or step outside (0, 1].
+ *  `outsideMesh` (optional, one entry per voxel,
+ *  RasterizationReport::outsideMask) splits the report into voxels the mesh
+ *  covers and voxels it does not; it does not change the repair. */
 FieldFoldRepairReport
 RemoveVoxelFolds(Volume<Vec3> & field, const FieldFoldRepairOptions & options = {},
                  const std::vector<std::uint8_t> * outsideMesh = nullptr);

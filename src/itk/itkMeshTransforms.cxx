@@ -9,10 +9,12 @@
 #include "morea_core/Error.h"
 #include "vnl/algo/vnl_determinant.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <functional>
 #include <future>
+#include <thread>
 #include <utility>
 
 namespace itk
@@ -232,7 +234,8 @@ RasterizeSolution(const morea_core::MeshTopology & topology, const morea_core::D
 
   // The map `from` -> `to` sampled on a grid's volume (plain C++, no ITK
   // objects made, so that both directions can run at once: the voxel fold
-  // repair is serial and takes a good part of a second on a folded field).
+  // repair takes a good part of a second on a folded field, and each
+  // direction's repair gets half of the cores).
   struct Rasterized
   {
     morea_core::Volume<morea_core::Vec3>  volume;
@@ -243,7 +246,10 @@ RasterizeSolution(const morea_core::MeshTopology & topology, const morea_core::D
                                      morea_core::Volume<morea_core::Vec3> volume) {
     Rasterized r{ std::move(volume), {}, {} };
     morea_core::RasterizeDisplacement(topology, from, to, r.volume, &r.report);
-    r.repair = morea_core::RemoveVoxelFolds(r.volume, {}, r.report.outsideMask.empty() ? nullptr : &r.report.outsideMask);
+    morea_core::FieldFoldRepairOptions repairOptions;
+    repairOptions.threads = std::max(1u, std::thread::hardware_concurrency() / 2);
+    r.repair = morea_core::RemoveVoxelFolds(r.volume, repairOptions,
+                                            r.report.outsideMask.empty() ? nullptr : &r.report.outsideMask);
     r.report.outsideMask = {}; // only needed to split the repair's report
     return r;
   };

@@ -316,8 +316,11 @@ WriteOutputFiles(const MultiObjectiveRegistrationRun & run, const morea_core::Pa
     auto repairJson = [](const morea_core::FieldFoldRepairReport & r, const morea_core::RasterizationReport & raster) {
       return nlohmann::json{ { "folded_voxels_before", r.foldedBefore },
                              { "folded_voxels_after", r.foldedAfter },
-                             { "voxels_smoothed", r.voxelsChanged },
+                             { "voxels_changed", r.voxelsChanged },
+                             { "voxels_changed_over_1mm", r.voxelsChangedOver1mm },
                              { "maximum_change_mm", r.maximumChange },
+                             { "projection_rounds", r.projectionRounds },
+                             { "smoothing_rounds", r.smoothingRounds },
                              { "voxels_outside_mesh", raster.outsideMesh },
                              { "folded_voxels_before_outside_mesh", r.foldedBeforeOutsideMesh },
                              { "maximum_change_inside_mesh_mm", r.maximumChangeInsideMesh } };
