@@ -1,8 +1,10 @@
 #!/usr/bin/env python3
 # Copyright 2026 The MultiObjectiveRegistration authors
 # SPDX-License-Identifier: Apache-2.0
-"""Removes a solution's voxel-level folds by projection, for comparison with
-the smoothing repair (bench/results/generation-budget.md).
+"""Removes a solution's voxel-level folds by projection: the NumPy experiment
+behind the product's repair (morea_core::RemoveVoxelFolds, which asks for a
+lift to twice the threshold and works only near folds), kept to repeat the
+experiment's rows in bench/results/generation-budget.md.
 
 Rasterises the solution's mesh map on the preprocessed grid as
 fold-origins.py does, then, each round, every voxel whose Jacobian
