@@ -43,7 +43,9 @@ struct SmallRun
            { "seed", "4" } })
       parameters.SetFromString(key, value);
     std::filesystem::create_directories(MOREA_TEST_OUTPUT_DIR);
-    checkpoint = std::string(MOREA_TEST_OUTPUT_DIR) + "/resume_checkpoint.bin";
+    // One file per test: CTest runs the tests of this file side by side.
+    checkpoint = std::string(MOREA_TEST_OUTPUT_DIR) + "/resume_checkpoint_" +
+                 ::testing::UnitTest::GetInstance()->current_test_info()->name() + ".bin";
     std::filesystem::remove(checkpoint);
   }
   ~SmallRun()

@@ -3,14 +3,17 @@
 // The thread pool: every index runs exactly once whatever the count and the
 // number of threads, an exception reaches the caller and stops the work, and
 // the pool stays usable for the next call.
+#include "morea_core/ParallelForThreads.h"
 #include "morea_core/ThreadPool.h"
 
 #include <gtest/gtest.h>
 
 #include <atomic>
 #include <chrono>
-#include <thread>
+#include <mutex>
+#include <set>
 #include <stdexcept>
+#include <thread>
 #include <vector>
 
 using morea_core::ThreadPool;
@@ -205,3 +208,24 @@ TEST(ThreadPool, IdlePriorityWorkersRunAtIdlePriority)
   EXPECT_EQ(policy, SCHED_IDLE);
 }
 #endif
+
+TEST(ThreadPool, TheHostThreadLimitHoldsForPoolsAndOneOffLoops)
+{
+  morea_core::SetHostThreadLimit(3);
+  EXPECT_EQ(morea_core::HostThreads(), 3u);
+  EXPECT_EQ(morea_core::ThreadPool(0).NumberOfThreads(), 3u);
+  EXPECT_EQ(morea_core::ThreadPool(5).NumberOfThreads(), 5u) << "an explicit count is kept";
+  std::mutex                  mutex;
+  std::set<std::thread::id>   seen;
+  std::atomic<std::size_t>    done{ 0 };
+  morea_core::ParallelForOnNewThreads(64, [&](std::size_t) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    std::lock_guard<std::mutex> lock(mutex);
+    seen.insert(std::this_thread::get_id());
+    ++done;
+  });
+  EXPECT_EQ(done.load(), 64u);
+  EXPECT_LE(seen.size(), 3u);
+  morea_core::SetHostThreadLimit(0);
+  EXPECT_EQ(morea_core::HostThreads(), std::max(1u, std::thread::hardware_concurrency()));
+}

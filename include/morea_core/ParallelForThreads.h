@@ -6,6 +6,8 @@
 #ifndef morea_ParallelForThreads_h
 #define morea_ParallelForThreads_h
 
+#include "morea_core/ThreadPool.h"
+
 #include <algorithm>
 #include <atomic>
 #include <cstddef>
@@ -14,7 +16,7 @@
 
 namespace morea_core
 {
-/** Runs body(item) for items [0, count) on up to one thread per core (the
+/** Runs body(item) for items [0, count) on up to HostThreads() threads (the
  *  caller's among them), handing out items one by one; returns when all are
  *  done. `body` must not throw. */
 template <typename TBody>
@@ -22,7 +24,7 @@ void
 ParallelForOnNewThreads(std::size_t count, TBody body)
 {
   const std::size_t threads =
-    std::max<std::size_t>(1, std::min<std::size_t>(count, std::thread::hardware_concurrency()));
+    std::max<std::size_t>(1, std::min<std::size_t>(count, HostThreads()));
   std::atomic<std::size_t> next{ 0 };
   auto                     worker = [&] {
     for (std::size_t item = next++; item < count; item = next++)

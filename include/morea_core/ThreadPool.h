@@ -29,6 +29,17 @@ enum class WorkerPriority
   Idle
 };
 
+/** Host threads the process's parallel work uses: the limit a tool set from
+ *  its --threads (SetHostThreadLimit), else one per hardware thread. Pools
+ *  made with 0 threads, one-off parallel loops and the voxel fold repair take
+ *  it, so that registrations side by side on one host (a batch, one per GPU)
+ *  keep to their share of the cores in every stage, not only the optimiser. */
+std::size_t
+HostThreads();
+/** 0 lifts the limit. */
+void
+SetHostThreadLimit(std::size_t threads);
+
 class ThreadPool
 {
 public:

@@ -18,6 +18,7 @@
 #include "morea_core/MemoryEstimate.h"
 #include "morea_core/MoRvGomea.h"
 #include "morea_core/TetrahedronObjectives.h"
+#include "morea_core/ThreadPool.h"
 
 #include <algorithm>
 #include <chrono>
@@ -26,7 +27,6 @@
 #include <iostream>
 #include <memory>
 #include <sstream>
-#include <thread>
 
 namespace morea_cli
 {
@@ -156,7 +156,7 @@ TimeBackend(const std::string & name, const itk::morea::MeshModel & model, const
                       { "samples_sampled_later",
                         total.boundSampledLaterSamples - afterInit.boundSampledLaterSamples },
                       { "parts_sampled_again", total.partsSampledAgain - afterInit.partsSampledAgain },
-                      { "threads", threads ? threads : std::max(1u, std::thread::hardware_concurrency()) },
+                      { "threads", threads ? threads : morea_core::HostThreads() },
                       { "first_generation", firstGeneration },
                       { "seconds_initial_population", secondsPopulation },
                       { "seconds_initial_evaluation", secondsInitialEvaluation },

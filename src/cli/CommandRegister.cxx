@@ -9,10 +9,12 @@
 #include "ZipArchive.h"
 
 #include "itkMOREAImageIO.h"
+#include "itkMultiThreaderBase.h"
 #include "itkRegistrationOutputs.h"
 #include "morea_core/CheckpointWriter.h"
 #include "morea_core/ComputeDevices.h"
 #include "morea_core/OutputFolderLock.h"
+#include "morea_core/ThreadPool.h"
 
 #include <chrono>
 #include <csignal>
@@ -168,7 +170,7 @@ AddRegisterCommand(CLI::App & app)
       "N, Ns, Nmin")
     ->capture_default_str();
   cmd->add_flag("--resume", options->resume, "continue from output/checkpoint.bin when it exists");
-  cmd->add_option("--threads", options->threads, "host threads (0: all)")->capture_default_str();
+  cmd->add_option("--threads", options->threads, "host threads for every stage of the run (0: all)")->capture_default_str();
   cmd->add_option("--backend", options->backend,
                   "where solutions are evaluated: auto (the GPU's texture path when a usable CUDA device is present, "
                   "else the CPU), cuda (the texture path), cuda-exact (software interpolation on the GPU, for "
@@ -192,6 +194,14 @@ AddRegisterCommand(CLI::App & app)
     namespace fs = std::filesystem;
     using Clock = std::chrono::steady_clock;
     const auto started = Clock::now();
+    // --threads holds for every stage (reading, preprocessing, outputs, ITK's
+    // filters), not only the optimiser: registrations side by side on one
+    // host (a batch, one per GPU) keep to their share of the cores.
+    if (options->threads > 0)
+    {
+      morea_core::SetHostThreadLimit(options->threads);
+      itk::MultiThreaderBase::SetGlobalDefaultNumberOfThreads(static_cast<itk::ThreadIdType>(options->threads));
+    }
     auto       parameters = options->parameters.Load();
     if (options->device)
       parameters.SetFromString("cuda_gpu_id", std::to_string(*options->device));

@@ -5,9 +5,9 @@
 #include "itkCommand.h"
 #include "itkTransformFileReader.h"
 #include "morea_core/Error.h"
+#include "morea_core/ThreadPool.h"
 
 #include <algorithm>
-#include <thread>
 
 namespace morea_cli
 {
@@ -60,7 +60,7 @@ MakeRegistrationFilter(const itk::morea::RegistrationProblem & problem, const Pa
   filter->SetParameters(parameters);
   filter->SetBackend(settings.backend);
   filter->SetNumberOfWorkUnits(static_cast<itk::ThreadIdType>(
-    settings.threads ? settings.threads : std::max(1u, std::thread::hardware_concurrency())));
+    settings.threads ? settings.threads : morea_core::HostThreads()));
   filter->SetRefusalBounds(settings.refusalBounds);
   filter->SetSelection(settings.selection);
   filter->SetCheckpointFile(settings.checkpointFile);

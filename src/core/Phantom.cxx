@@ -4,6 +4,7 @@
 
 #include "morea_core/Error.h"
 #include "morea_core/Random.h"
+#include "morea_core/ThreadPool.h"
 
 #include <algorithm>
 #include <cmath>
@@ -126,7 +127,7 @@ InBowelGas(const Vec3 & x, double lift)
 void
 ParallelFor(std::size_t count, const std::function<void(std::size_t)> & body)
 {
-  const std::size_t threads = std::max<std::size_t>(1, std::min<std::size_t>(count, std::thread::hardware_concurrency()));
+  const std::size_t threads = std::max<std::size_t>(1, std::min<std::size_t>(count, HostThreads()));
   std::vector<std::thread> pool;
   for (std::size_t t = 0; t < threads; ++t)
   {

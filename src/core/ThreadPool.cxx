@@ -104,11 +104,29 @@ ChangeAndWake(std::atomic<std::uint32_t> & word, std::size_t count, std::mutex &
 }
 } // namespace
 
+namespace
+{
+std::atomic<std::size_t> hostThreadLimit{ 0 };
+} // namespace
+
+std::size_t
+HostThreads()
+{
+  const std::size_t limit = hostThreadLimit.load();
+  return limit > 0 ? limit : std::max<std::size_t>(1, std::thread::hardware_concurrency());
+}
+
+void
+SetHostThreadLimit(std::size_t threads)
+{
+  hostThreadLimit.store(threads);
+}
+
 std::shared_ptr<ThreadPool>
 ThreadPool::Shared(std::size_t threads)
 {
   if (threads == 0)
-    threads = std::max<std::size_t>(1, std::thread::hardware_concurrency());
+    threads = HostThreads();
   static std::mutex                                   mutex;
   static std::map<std::size_t, std::weak_ptr<ThreadPool>> pools;
   std::lock_guard<std::mutex>                         lock(mutex);
@@ -124,7 +142,7 @@ ThreadPool::Shared(std::size_t threads)
 ThreadPool::ThreadPool(std::size_t threads, WorkerPriority priority)
 {
   if (threads == 0)
-    threads = std::max<std::size_t>(1, std::thread::hardware_concurrency());
+    threads = HostThreads();
   for (std::size_t i = 1; i < threads; ++i)
     m_Workers.emplace_back([this, priority] {
       SetOwnPriority(priority);

@@ -12,6 +12,7 @@
 #include "morea_core/MeshRefinement.h"
 #include "morea_core/ParameterSet.h"
 #include "morea_core/TetrahedronObjectives.h"
+#include "morea_core/ThreadPool.h"
 
 #include <algorithm>
 #include <chrono>
@@ -19,7 +20,6 @@
 #include <future>
 #include <optional>
 #include <string>
-#include <thread>
 #include <utility>
 
 namespace itk
@@ -165,7 +165,7 @@ RegisterMeshes(const RegistrationProblem & problem, const morea_core::ParameterS
   request.device = options.device;
   request.minimumComputeLevel = options.minimumComputeLevel;
   request.threads = options.threads;
-  result.threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+  result.threads = options.threads ? options.threads : morea_core::HostThreads();
 
   morea_core::GomeaOptions baseOptions = morea_core::GomeaOptions::FromParameters(parameters);
   baseOptions.threads = options.threads; // the backend's pool: the two take turns on it

@@ -7,6 +7,7 @@
 #include "itkPhantomImages.h"
 #include "itkRegistrationEvaluation.h"
 #include "morea_core/Error.h"
+#include "morea_core/ThreadPool.h"
 #include "vnl/algo/vnl_determinant.h"
 
 #include <algorithm>
@@ -14,7 +15,6 @@
 #include <cstdio>
 #include <functional>
 #include <future>
-#include <thread>
 #include <utility>
 
 namespace itk
@@ -247,7 +247,7 @@ RasterizeSolution(const morea_core::MeshTopology & topology, const morea_core::D
     Rasterized r{ std::move(volume), {}, {} };
     morea_core::RasterizeDisplacement(topology, from, to, r.volume, &r.report);
     morea_core::FieldFoldRepairOptions repairOptions;
-    repairOptions.threads = std::max(1u, std::thread::hardware_concurrency() / 2);
+    repairOptions.threads = std::max<std::size_t>(1, morea_core::HostThreads() / 2);
     r.repair = morea_core::RemoveVoxelFolds(r.volume, repairOptions,
                                             r.report.outsideMask.empty() ? nullptr : &r.report.outsideMask);
     r.report.outsideMask = {}; // only needed to split the repair's report

@@ -9,6 +9,7 @@
 #include "itkMOREAImageIO.h"
 #include "itkPreprocessing.h"
 #include "itkRTStructureSetIO.h"
+#include "morea_core/ThreadPool.h"
 
 #include <algorithm>
 #include <atomic>
@@ -18,7 +19,6 @@
 #include <future>
 #include <map>
 #include <mutex>
-#include <thread>
 
 namespace fs = std::filesystem;
 
@@ -300,7 +300,7 @@ RegistrationProblem::LoadStructures(const std::vector<StructureSource> & sources
   std::vector<std::future<void>>  tasks;
   std::vector<std::exception_ptr> errors(sources.size());
   std::atomic<std::size_t>        next{ 0 };
-  const std::size_t readers = std::min<std::size_t>(sources.size(), std::max(1u, std::thread::hardware_concurrency()));
+  const std::size_t readers = std::min<std::size_t>(sources.size(), morea_core::HostThreads());
   for (std::size_t r = 0; r < readers; ++r)
     tasks.push_back(std::async(std::launch::async, [&] {
       for (std::size_t i = next++; i < sources.size(); i = next++)
