@@ -46,8 +46,8 @@ struct FieldFoldRepairOptions
   double       projectionTarget{ 0.01 };
   double       projectionStep{ 0.9 };
   unsigned int maximumProjectionRounds{ 3000 };
-  /** Threads of the projection (0: one per hardware thread); the result
-   *  does not depend on them. */
+  /** Threads of the projection (0: HostThreads()); the result does not
+   *  depend on them. */
   std::size_t threads{ 0 };
   /** The last resort, for folds the projection leaves: rounds of smoothing
    *  before giving up (the remaining folds are reported). */

@@ -192,28 +192,17 @@ RequestAt(const Volume<Vec3> & field, std::size_t voxel, double target)
   return r;
 }
 
-/** Calls f(i) for i in [0, count) in chunks spread over the pool. */
-template <typename F>
-void
-ParallelChunks(ThreadPool & pool, std::size_t count, F && f)
-{
-  constexpr std::size_t chunk = 512;
-  pool.ParallelFor((count + chunk - 1) / chunk, [&](std::size_t c) {
-    for (std::size_t i = c * chunk; i < std::min(count, (c + 1) * chunk); ++i)
-      f(i);
-  });
-}
-
 /** The projection: every voxel whose determinant is below half the target
  *  asks for the smallest change of its stencil's displacements that lifts the
  *  determinant, linearised, to the target; the requests are summed and a
  *  step of the sum applied, in rounds, until no determinant is <= 0 or the
  *  rounds run out. Each voxel gathers the requests of the determinants that
  *  read it in a fixed order, so the result does not depend on the threads.
- *  `determinant` holds every voxel's current determinant on entry and on
- *  return; `changed` marks the voxels moved. Returns the rounds. */
+ *  `folded` counts the determinants <= 0 on entry; `determinant` holds every
+ *  voxel's current determinant on entry and on return; `changed` marks the
+ *  voxels moved. Returns the rounds. */
 unsigned int
-ProjectOntoPositiveDeterminants(Volume<Vec3> & field, const FieldFoldRepairOptions & options,
+ProjectOntoPositiveDeterminants(Volume<Vec3> & field, const FieldFoldRepairOptions & options, std::size_t folded,
                                 std::vector<double> & determinant, std::vector<std::uint8_t> & changed)
 {
   const std::size_t        n = field.NumberOfVoxels();
@@ -223,16 +212,12 @@ ProjectOntoPositiveDeterminants(Volume<Vec3> & field, const FieldFoldRepairOptio
   // (on the abdominal pair's fields a tenth of the time, the same changes).
   const double             threshold = 0.5 * target;
   constexpr std::uint32_t  none = 0xffffffffu;
+  if (options.maximumProjectionRounds == 0)
+    return 0;
   std::vector<std::size_t> active; // determinant below the threshold
-  std::size_t              folded{ 0 };
   for (std::size_t o = 0; o < n; ++o)
-  {
-    folded += determinant[o] <= 0.0;
     if (determinant[o] < threshold)
       active.push_back(o);
-  }
-  if (folded == 0 || options.maximumProjectionRounds == 0)
-    return 0;
   if (active.size() >= none)
     throw Error("voxel fold repair: too many voxels near folds (" + std::to_string(active.size()) + ")");
 
@@ -265,13 +250,13 @@ ProjectOntoPositiveDeterminants(Volume<Vec3> & field, const FieldFoldRepairOptio
     requests.resize(active.size());
     for (std::size_t a = 0; a < active.size(); ++a)
       activeIndex[active[a]] = static_cast<std::uint32_t>(a);
-    ParallelChunks(pool, active.size(), [&](std::size_t a) { requests[a] = RequestAt(field, active[a], target); });
+    pool.ParallelFor(active.size(), [&](std::size_t a) { requests[a] = RequestAt(field, active[a], target); });
 
     // The stencil relation is symmetric: a voxel is read by the determinants
     // of itself and its face neighbours.
     collectReaders(active, moved);
     delta.resize(moved.size());
-    ParallelChunks(pool, moved.size(), [&](std::size_t m) {
+    pool.ParallelFor(moved.size(), [&](std::size_t m) {
       const std::size_t p = moved[m];
       Vec3              sum{ { 0.0, 0.0, 0.0 } };
       ForEachReader(field, p, [&](std::size_t t) {
@@ -287,7 +272,7 @@ ProjectOntoPositiveDeterminants(Volume<Vec3> & field, const FieldFoldRepairOptio
       });
       delta[m] = sum;
     });
-    ParallelChunks(pool, moved.size(), [&](std::size_t m) {
+    pool.ParallelFor(moved.size(), [&](std::size_t m) {
       if (delta[m][0] == 0.0 && delta[m][1] == 0.0 && delta[m][2] == 0.0)
         return; // read only by determinants that ask nothing of it
       for (int c = 0; c < 3; ++c)
@@ -299,7 +284,7 @@ ProjectOntoPositiveDeterminants(Volume<Vec3> & field, const FieldFoldRepairOptio
 
     collectReaders(moved, touched);
     touchedDeterminant.resize(touched.size());
-    ParallelChunks(pool, touched.size(), [&](std::size_t t) { touchedDeterminant[t] = DeterminantAt(field, touched[t]); });
+    pool.ParallelFor(touched.size(), [&](std::size_t t) { touchedDeterminant[t] = DeterminantAt(field, touched[t]); });
     for (const std::size_t o : active)
       marked[o] = 1;
     for (std::size_t t = 0; t < touched.size(); ++t)
@@ -435,7 +420,7 @@ RemoveVoxelFolds(Volume<Vec3> & field, const FieldFoldRepairOptions & options,
 
   const std::vector<Vec3>   original = field.data;
   std::vector<std::uint8_t> changed(n, 0);
-  report.projectionRounds = ProjectOntoPositiveDeterminants(field, options, determinant, changed);
+  report.projectionRounds = ProjectOntoPositiveDeterminants(field, options, folded.size(), determinant, changed);
   folded.clear();
   for (std::size_t o = 0; o < n; ++o)
     if (determinant[o] <= 0.0)
