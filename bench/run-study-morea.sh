@@ -9,8 +9,9 @@
 #   Here (2):     bench/run-study-morea.sh bundle STUDY/PAIR...
 #                 packs build/bin/morea (as built; nothing is rebuilt), the libraries it
 #                 needs and each pair's small inputs (problem/, landmarks/, morea_job.json,
-#                 morea_parameters.toml; not the raw images: the phantom is written again
-#                 there and checked against the study's checksums) into
+#                 morea_parameters.toml; a data pair's raw files (lung-paper, abdomen-paper;
+#                 from ../shared/data or $MOREA_SHARED_DATA_DIR); not the phantom's images:
+#                 they are written again there and checked against the study's checksums) into
 #                 device-carry/study-morea.tar.xz (git-ignored: name it in carry).
 #   On the GPU:   bench/run-study-morea.sh run "$OUT"
 #                 per pair, MOREA configuration and seed: `morea register` on the raw
@@ -71,6 +72,13 @@ case "${1:-}" in
       cp "$d/morea_job.json" "$d/morea_parameters.toml" "$stage/$pair/"
       cp -r "$d/problem" "$stage/$pair/"
       [ -d "$d/landmarks" ] && cp -r "$d/landmarks" "$stage/$pair/"
+      # A data pair's raw files (morea_job.json's raw_files, relative to the data folder).
+      data_root=${MOREA_SHARED_DATA_DIR:-../shared/data}
+      while IFS= read -r f; do
+        [ -n "$f" ] || continue
+        mkdir -p "$stage/$pair/raw/$(dirname "$f")"
+        cp "$data_root/$f" "$stage/$pair/raw/$f"
+      done < <(python3 -c "import json,sys; print('\n'.join(json.load(open(sys.argv[1])).get('raw_files', [])))" "$d/morea_job.json")
       data+=(--data "$stage/$pair")
     done
     MOREA_BUNDLE=${MOREA_BUNDLE:-device-carry/study-morea.tar.xz} \
@@ -127,6 +135,7 @@ case "${1:-}" in
       raw_args=()
       case_args=$(jq_ "$job" "' '.join(d.get('phantom_arguments') or []) if 'phantom_arguments' in d else '-'")
       raw="$work/raw/$pair"
+      [ -d "$pd/raw" ] && raw="$pd/raw"   # a data pair's files, carried in the bundle
       if [ "$case_args" != "-" ]; then
         if ! python3 -m study.morea_record md5 "$raw" "$job" 2>/dev/null; then
           rm -rf "$raw"

@@ -38,6 +38,11 @@ class Pair:
     morea_variants: dict[str, list[str]] = field(default_factory=lambda: {"default": []})
     # Score the landmarks per kind (phantom.json's landmark_kinds).
     landmarks_by_kind: bool = False
+    # MOREA at the paper's configuration: it runs on a GPU
+    # (bench/run-study-morea.sh), not in `study run` (unless --local-morea).
+    morea_on_gpu: bool = False
+    # The data pair whose images it registers (lung, abdomen), or "".
+    data_pair: str = ""
 
 
 # The phantom suite at the paper's MOREA configuration (the GPU runs MOREA):
@@ -51,7 +56,11 @@ PHANTOM_SUITE = {
 }
 # Guidance without bones: every structure but bones and the body outline.
 NO_BONE_GUIDANCE = "bladder,rectum,bowel"
-NAMES = ["lung", "abdomen", "phantom", *PHANTOM_SUITE]
+# The data pairs at the paper's budgets: the same problems (3 mm) as "lung" and
+# "abdomen", MOREA at the paper's configuration on a GPU, the competitors'
+# paper profile.
+PAPER_BUDGET = {"lung-paper": "lung", "abdomen-paper": "abdomen"}
+NAMES = ["lung", "abdomen", "phantom", *PHANTOM_SUITE, *PAPER_BUDGET]
 
 
 def data_dir(explicit: str | None = None) -> Path:
@@ -60,18 +69,25 @@ def data_dir(explicit: str | None = None) -> Path:
 
 def make(name: str, quick: bool) -> Pair:
     P = common.PARAMS_DIR
+    if name in PAPER_BUDGET:
+        pair = make(PAPER_BUDGET[name], quick)
+        pair.name = name
+        pair.description += ", at the paper's budgets (MOREA's paper configuration on a GPU)"
+        pair.morea_parameters = P / f"morea_{pair.data_pair}_paper.toml"
+        pair.morea_on_gpu = True
+        return pair
     if name == "lung":
         return Pair("lung", "lung CT pair (fixed baseline, moving followup; 51 landmark pairs)",
                     P / "morea_lung.toml", "lungs",
                     [Criterion("tre_mean_mm", False, "TRE mean (mm)"),
                      Criterion("dice:lungs", True, "lungs Dice"),
-                     Criterion("hd95:lungs", False, "lungs HD95 (mm)")])
+                     Criterion("hd95:lungs", False, "lungs HD95 (mm)")], data_pair="lung")
     if name == "abdomen":
         s = "Stomach_duo_CBCT"
         return Pair("abdomen", "abdominal CBCT pair (fixed CB02, moving CB07)",
                     P / "morea_abdomen.toml", s,
                     [Criterion(f"dice:{s}", True, "stomach Dice"),
-                     Criterion(f"hd95:{s}", False, "stomach HD95 (mm)")])
+                     Criterion(f"hd95:{s}", False, "stomach HD95 (mm)")], data_pair="abdomen")
     if name == "phantom":
         return Pair("phantom", "synthetic pelvis phantom (bladder filling), `morea phantom`",
                     P / ("morea_phantom_quick.toml" if quick else "morea_phantom.toml"), "bladder",
@@ -88,7 +104,7 @@ def make(name: str, quick: bool) -> Pair:
             criteria.insert(2, Criterion("dice:bladder", True, "bladder Dice"))
         return Pair(name, f"phantom suite, `morea phantom --case {case}` ({what})",
                     P / f"morea_{name.replace('-', '_')}.toml", organ, criteria,
-                    needs_data=False, phantom_case=case, landmarks_by_kind=True,
+                    needs_data=False, phantom_case=case, landmarks_by_kind=True, morea_on_gpu=True,
                     morea_variants={"default": [], "no-bone-guidance": [
                         "--set", f"problem_guidance_selection={NO_BONE_GUIDANCE}"]})
     raise SystemExit(f"unknown pair {name!r} ({', '.join(NAMES)})")
@@ -96,7 +112,7 @@ def make(name: str, quick: bool) -> Pair:
 
 def resolve(pair: Pair, data: Path, out: Path, morea: str) -> None:
     """Fills pair.raw_args; for the phantom writes the raw pair under out/raw."""
-    if pair.name == "lung":
+    if pair.data_pair == "lung":
         d = data / "lung-ct-pair"
         _require(d)
         pair.raw_args = [
@@ -105,7 +121,7 @@ def resolve(pair: Pair, data: Path, out: Path, morea: str) -> None:
             "--moving-structure", f"lungs={d / 'followup_lung_mask.mha'}",
             "--fixed-landmarks", str(d / "baseline_landmarks51_mm.txt"),
             "--moving-landmarks", str(d / "followup_landmarks51_mm.txt")]
-    elif pair.name == "abdomen":
+    elif pair.data_pair == "abdomen":
         d = data / "abdomen-cbct-pair"
         _require(d)
         args = ["--fixed", str(d / "CB02.mha"), "--moving", str(d / "CB07.mha")]

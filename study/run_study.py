@@ -7,9 +7,10 @@
     python3 -m study report --pair ... --out DIR     (tables and plots again)
     python3 -m study rescore --pair ... --out DIR    (scores again, then report)
 
-PAIR: lung, abdomen, phantom (the small CI pair), or the phantom suite at the
+PAIR: lung, abdomen, phantom (the small CI pair), the phantom suite at the
 paper's MOREA configuration: phantom-pelvis, phantom-emptying, phantom-gas,
-phantom-static (study/pairs.py).
+phantom-static, or the data pairs at the paper's budgets: lung-paper,
+abdomen-paper (study/pairs.py).
 
 Steps (each run is skipped when its scores.json exists, so a killed study resumes):
  1. `morea preprocess` with the MOREA parameter file of the pair -> DIR/problem,
@@ -31,7 +32,8 @@ Steps (each run is skipped when its scores.json exists, so a killed study resume
     tests of MOREA against each competitor (Bonferroni: alpha 0.05 / 2 = 0.025),
     a parallel-coordinates plot and renders of seed 1 of each method.
 
-MOREA on the phantom suite runs on a GPU: `prepare` here, bench/run-study-morea.sh
+MOREA at the paper's configuration (the phantom suite, lung-paper, abdomen-paper)
+runs on a GPU: `prepare` here, bench/run-study-morea.sh
 there, its archive unpacked into DIR; `run` then finds those runs' scores.json
 and skips them (without them it registers MOREA here only with --local-morea).
 
@@ -100,7 +102,7 @@ def config_name(method: str, weight: float | None, scale: int = 1, variant: str 
 def default_profile(pair: pairs.Pair, quick: bool) -> str:
     if quick:
         return "quick"
-    return "paper" if pair.phantom_case else "reduced"
+    return "paper" if pair.morea_on_gpu else "reduced"
 
 
 def resolve_settings(profile: dict, spacing_mm: float | None) -> dict:
@@ -223,7 +225,22 @@ class Study:
             job["raw_md5"] = {str(p.relative_to(raw)): common.md5(p)
                               for p in sorted(raw.rglob("*.nii.gz"))}
         else:
-            job["raw_args"] = [str(a) for a in self.pair.raw_args]
+            # The data pair's files travel with the bundle (raw/, the same
+            # relative paths), so that the GPU machine reads what was read here.
+            data = pairs.data_dir(self.args.data).resolve()
+            job["raw_args"], job["raw_files"] = [], []
+            for a in map(str, self.pair.raw_args):
+                path, sep, rest = a.rpartition("=")[2].partition(":")
+                if Path(path).is_absolute() and Path(path).resolve().is_relative_to(data):
+                    relative = str(Path(path).resolve().relative_to(data))
+                    # A label map named by label (path:name) reads its names beside it.
+                    names = Path(path).with_suffix(".txt")
+                    extra = [str(names.resolve().relative_to(data))] if rest and names.exists() else []
+                    for f in [relative, *extra]:
+                        if f not in job["raw_files"]:
+                            job["raw_files"].append(f)
+                    a = a.replace(path, "{raw}/" + relative, 1)
+                job["raw_args"].append(a)
         common.write_json(self.out / "morea_job.json", job)
 
     # -- one run --------------------------------------------------------------
@@ -242,7 +259,7 @@ class Study:
             return common.read_json(scores_path)
         if (d / "failed.json").exists() and not self.args.retry_failed:
             return None
-        if method == "morea" and self.pair.phantom_case and not self.args.local_morea:
+        if method == "morea" and self.pair.morea_on_gpu and not self.args.local_morea:
             self.say(f"morea {variant} seed {seed}: no result (run bench/run-study-morea.sh on "
                      "a GPU and unpack its archive here, or pass --local-morea)")
             return None
@@ -478,7 +495,7 @@ def main(argv=None):
     ap.add_argument("--profile", choices=["reduced", "paper"],
                     help="competitors' budgets: reduced (the first study's) or paper "
                          "(appendix C, with the convergence check); default: paper for the "
-                         "phantom suite, reduced otherwise")
+                         "phantom suite and the -paper pairs, reduced otherwise")
     ap.add_argument("--morea", help="the morea binary (default: $MOREA, build/bin/morea, PATH)")
     ap.add_argument("--data", help="folder with lung-ct-pair/ and abdomen-cbct-pair/")
     ap.add_argument("--threads", type=int, default=2)
@@ -487,7 +504,8 @@ def main(argv=None):
                     help="seeds per configuration in the regularisation sweep")
     ap.add_argument("--skip", nargs="*", choices=["morea", "elastix", "ants"])
     ap.add_argument("--local-morea", action="store_true",
-                    help="phantom suite: register MOREA here when the GPU's results are missing")
+                    help="pairs whose MOREA runs on a GPU: register it here when the GPU's "
+                         "results are missing")
     ap.add_argument("--no-convergence-check", action="store_true")
     ap.add_argument("--retry-failed", action="store_true")
     ap.add_argument("--fresh", action="store_true",
