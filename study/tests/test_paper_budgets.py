@@ -37,6 +37,9 @@ def test_paper_budget_pairs_register_the_first_studys_problem(name):
                 "morea_sampling_rate"):
         assert p[key] == paper[key], key
     assert p["morea_mesh_surface_structures"] == small["morea_mesh_surface_structures"]
+    assert pair.morea_variants["default"] == []
+    if name == "abdomen-paper":
+        assert pair.morea_variants["1000-generations"] == ["--set", "ea_num_generations=1000"]
 
 
 def test_job_carries_a_data_pairs_files(tmp_path, monkeypatch):
