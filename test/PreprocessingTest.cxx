@@ -4,6 +4,7 @@
 #include "itkImageRegionConstIterator.h"
 #include "itkImageRegionIteratorWithIndex.h"
 #include "itkMOREAImageIO.h"
+#include "itkMinimumMaximumImageCalculator.h"
 #include "itkPhantomImages.h"
 #include "itkPreprocessing.h"
 #include "itkRegistrationMetrics.h"
@@ -308,6 +309,35 @@ TEST(Preprocessing, UnknownStructuresAndBadOptionsAreErrors)
   pre.windowMin = 100.0f;
   pre.windowMax = -100.0f;
   EXPECT_THROW(Preprocess(problem, pre), itk::ExceptionObject);
+}
+
+TEST(Preprocessing, ImagesWindowedAlreadyAreRefusedUnderAHounsfieldWindow)
+{
+  morea_core::PhantomOptions options;
+  options.spacing = 5.0;
+  const auto problem = MakePhantomProblem(morea_core::PelvisPhantom(options).Generate());
+  PreprocessOptions pre;
+  pre.isotropicSpacing = 5.0;
+  const auto once = Preprocess(problem, pre).problem; // values in [0, 1] now
+  try
+  {
+    Preprocess(once, pre);
+    FAIL() << "a problem preprocessed already was windowed again";
+  }
+  catch (const itk::ExceptionObject & e)
+  {
+    const std::string message = e.GetDescription();
+    EXPECT_NE(message.find("values lie in [0, 1]"), std::string::npos) << message;
+    EXPECT_NE(message.find("preprocess_intensity_max = 1"), std::string::npos) << message;
+  }
+  // Normalised images under their own window are fine, and keep their contrast.
+  pre.windowMin = 0.0f;
+  pre.windowMax = 1.0f;
+  const auto twice = Preprocess(once, pre).problem;
+  auto range = itk::MinimumMaximumImageCalculator<ImageType>::New();
+  range->SetImage(twice.fixedImage);
+  range->Compute();
+  EXPECT_GT(range->GetMaximum() - range->GetMinimum(), 0.5f);
 }
 
 TEST(Preprocessing, AnAbsurdSpacingIsRefusedWithTheFigures)

@@ -5,9 +5,14 @@
 
 #include "itkMOREAImageIO.h"
 #include "itkMeshModel.h"
+#include "itkMinimumMaximumImageCalculator.h"
+#include "itkObjectiveData.h"
 #include "itkPreprocessing.h"
+#include "itkVectorLinearInterpolateImageFunction.h"
+#include "morea_core/Error.h"
 #include "morea_core/FoldConstraint.h"
 #include "morea_core/InitialPopulation.h"
+#include "morea_core/TetrahedronObjectives.h"
 
 #include <chrono>
 #include <filesystem>
@@ -56,6 +61,45 @@ ReportToJson(const itk::morea::MeshModel & model)
   j["notes"] = model.report.notes;
   return j;
 }
+
+/** The mesh carried by a moving-to-fixed displacement field: the source
+ *  (moving) points where the mesh has them, the target (fixed) points where
+ *  the field takes them. Throws when a point lies outside the field. */
+morea_core::DualMesh
+CarriedByField(const itk::morea::MeshModel & model, const std::string & path)
+{
+  const auto field = itk::morea::ReadDisplacementField(path);
+  using Interpolator = itk::VectorLinearInterpolateImageFunction<itk::morea::DisplacementFieldType, double>;
+  auto interpolator = Interpolator::New();
+  interpolator->SetInputImage(field);
+  auto solution = morea_core::DualMesh::FromBase(model.base);
+  for (std::size_t i = 0; i < solution.source.size(); ++i)
+  {
+    const auto point = model.frame.ToPhysical(solution.source[i]);
+    if (!interpolator->IsInsideBuffer(point))
+      throw morea_core::Error(path + ": mesh point " + std::to_string(i) + " lies outside the field");
+    const auto u = interpolator->Evaluate(point);
+    const auto displacement = model.frame.VectorToFrame(itk::morea::DisplacementVectorType(u.GetDataPointer()));
+    for (int a = 0; a < 3; ++a)
+      solution.target[i][a] = solution.source[i][a] + displacement[a];
+  }
+  return solution;
+}
+
+nlohmann::json
+ObjectivesToJson(const morea_core::TetrahedronEvaluator & evaluator, const morea_core::DualMesh & solution,
+                 std::size_t tetrahedra)
+{
+  morea_core::ObjectiveTotals totals;
+  for (std::size_t t = 0; t < tetrahedra; ++t)
+    totals.Add(evaluator.Evaluate(t, solution));
+  const auto fitness = totals.ToFitness(tetrahedra);
+  return { { "magnitude", fitness.objectives[0] },
+           { "intensity", fitness.objectives[1] },
+           { "guidance", fitness.objectives[2] },
+           { "feasible", fitness.feasible },
+           { "folded_tetrahedra", std::llround(totals.sum.folded) } };
+}
 } // namespace
 
 void
@@ -67,6 +111,7 @@ AddMeshCommand(CLI::App & app)
     ParameterOptions parameters;
     std::string      output;
     std::size_t      samples{ 0 };
+    std::vector<std::string> objectivesOf;
   };
   auto   options = std::make_shared<Options>();
   auto * cmd = app.add_subcommand("mesh", "build the mesh model of a problem and write it as .vtu (SPEC 4.3-4.5)");
@@ -76,6 +121,10 @@ AddMeshCommand(CLI::App & app)
   cmd->add_option("--samples", options->samples,
                   "also write this many random initial solutions (meshes and displacement fields)")
     ->check(CLI::Range(0, 1000));
+  cmd->add_option("--objectives-of", options->objectivesOf,
+                  "NAME=FIELD: the objectives (as morea register scores a solution) of the map a moving-to-fixed "
+                  "displacement field gives this mesh, e.g. another method's result or a known truth; written to "
+                  "mesh.json with those of the identity");
   cmd->callback([options] {
     const auto parameters = options->parameters.Load();
     auto       problem = options->problem.Load();
@@ -86,13 +135,53 @@ AddMeshCommand(CLI::App & app)
       itk::morea::CheckGuidanceStructuresKept(preprocessed.report, parameters); // as morea register does
       problem = std::move(preprocessed.problem);
     }
+    for (const auto & entry : options->objectivesOf)
+      if (entry.find('=') == std::string::npos || entry.front() == '=' || entry.back() == '=')
+        throw morea_core::Error("--objectives-of: expected NAME=FIELD, got '" + entry + "'");
+    if (!options->objectivesOf.empty())
+    {
+      // As a registration scores them: on windowed images (values in [0, 1]).
+      for (const auto * image : { problem.fixedImage.GetPointer(), problem.movingImage.GetPointer() })
+      {
+        auto range = itk::MinimumMaximumImageCalculator<itk::morea::ImageType>::New();
+        range->SetImage(image);
+        range->Compute();
+        if (range->GetMinimum() < 0.0f || range->GetMaximum() > 1.0f)
+          throw morea_core::Error("--objectives-of scores a map as a registration does, on its preprocessed "
+                                  "images: give the problem `morea preprocess` wrote (or a registration's "
+                                  "preprocessed/ folder); these images have values outside [0, 1]");
+      }
+    }
     const auto model = itk::morea::BuildMeshModel(problem, parameters);
+    nlohmann::json objectives; // before anything is written: a field may be unreadable
+    if (!options->objectivesOf.empty())
+    {
+      const auto data = itk::morea::BuildObjectiveData(problem, model.frame, parameters);
+      const morea_core::FoldConstraint constraint(model.topology, model.base.points,
+                                                  parameters.GetReal("morea_fold_volume_fraction"));
+      const morea_core::TetrahedronEvaluator evaluator(model.topology, constraint, model.elasticity, model.rigidity,
+                                                       data);
+      const std::size_t tetrahedra = model.base.NumberOfTetrahedra();
+      objectives["identity"] = ObjectivesToJson(evaluator, morea_core::DualMesh::FromBase(model.base), tetrahedra);
+      for (const auto & entry : options->objectivesOf)
+      {
+        const std::string name = entry.substr(0, entry.find('='));
+        const auto        carried = CarriedByField(model, entry.substr(entry.find('=') + 1));
+        objectives[name] = ObjectivesToJson(evaluator, carried, tetrahedra);
+      }
+      for (const auto & [name, o] : objectives.items())
+        std::cout << "objectives of " << name << ": magnitude " << o["magnitude"].get<double>() << ", intensity "
+                  << o["intensity"].get<double>() << ", guidance " << o["guidance"].get<double>()
+                  << (o["feasible"].get<bool>() ? "" : ", folded") << "\n";
+    }
     std::filesystem::create_directories(options->output);
     const std::string out = options->output + "/";
     const auto        base = morea_core::DualMesh::FromBase(model.base);
     itk::morea::WriteSolutionMeshes(model, base, out + "mesh_moving.vtu", out + "mesh_fixed.vtu");
 
     nlohmann::json report = ReportToJson(model);
+    if (!objectives.is_null())
+      report["objectives"] = objectives;
     if (options->samples > 0)
     {
       const auto                  start = std::chrono::steady_clock::now();

@@ -1,6 +1,8 @@
 // Copyright 2026 The MultiObjectiveRegistration authors
 // SPDX-License-Identifier: Apache-2.0
 #include "itkPreprocessing.h"
+
+#include "itkMinimumMaximumImageCalculator.h"
 #include "itkMOREAFail.h"
 
 #include "itkImageRegionConstIterator.h"
@@ -440,6 +442,33 @@ AxisAlignedProblem(const RegistrationProblem & input)
   }
   return out;
 }
+/** Images whose values all lie in [0, 1] (a problem `morea preprocess` or a
+ *  run's preprocessed/ folder holds, or images normalised elsewhere) under a
+ *  window of Hounsfield units would be squashed into a sliver of it, leaving
+ *  the intensity objective nearly flat: refused, with what to do instead. */
+void
+FailOnWindowedImages(const RegistrationProblem & problem, const PreprocessOptions & options)
+{
+  constexpr double WidestWindowForUnitImages = 100.0;
+  if (options.windowMax - options.windowMin < WidestWindowForUnitImages)
+    return;
+  for (const auto & [side, image] : { std::pair<const char *, const ImageType *>{ "fixed", problem.fixedImage },
+                                      std::pair<const char *, const ImageType *>{ "moving", problem.movingImage } })
+  {
+    auto range = MinimumMaximumImageCalculator<ImageType>::New();
+    range->SetImage(image);
+    range->Compute();
+    if (range->GetMinimum() < 0.0f || range->GetMaximum() > 1.0f)
+      return;
+    if (std::string(side) == "moving")
+      Fail("preprocessing: the images' values lie in [0, 1], as in a problem that `morea preprocess` (or a "
+           "registration's preprocessed/ folder) holds, but the intensity window is [" +
+           std::to_string(options.windowMin) + ", " + std::to_string(options.windowMax) +
+           "]: windowing them again would flatten them. Register the original images (registration "
+           "preprocesses them itself), or set preprocess_intensity_min = 0 and preprocess_intensity_max = 1 "
+           "for images normalised already.");
+  }
+}
 } // namespace
 
 PreprocessResult
@@ -452,6 +481,7 @@ Preprocess(const RegistrationProblem & given, const PreprocessOptions & options)
     Fail("preprocessing: isotropic spacing must be positive");
   if (!(options.windowMax > options.windowMin))
     Fail("preprocessing: the intensity window maximum must exceed its minimum");
+  FailOnWindowedImages(input, options);
   PreprocessResult result;
   auto &           report = result.report;
 

@@ -392,6 +392,20 @@ expect_failure("mesh: unknown rigid structure" OUTPUTS ${o} FRAGMENTS "morea_rig
   ARGS mesh --fixed "${fixed}" --moving "${moving}" ${blob} --set morea_rigid_structures=femur -o "${o}")
 expect_failure("mesh: negative rigid weight" OUTPUTS ${o} FRAGMENTS "morea_rigid_weight"
   ARGS mesh --fixed "${fixed}" --moving "${moving}" ${blob} --set morea_rigid_weight=-1 -o "${o}")
+# --objectives-of: a field that is not there, and images not preprocessed; nothing written.
+expect_failure("mesh: objectives of a missing field" OUTPUTS ${o} FRAGMENTS "no_such_field.nii.gz"
+  ARGS mesh --problem "${WORK}/pre-control" --set morea_mesh_num_points=40
+       --objectives-of "x=${in}/no_such_field.nii.gz" -o "${o}")
+expect_failure("mesh: objectives on raw images" OUTPUTS ${o} FRAGMENTS "--objectives-of" "preprocessed"
+  ARGS mesh --fixed "${fixed}" --moving "${moving}" ${blob} --set morea_mesh_num_points=40
+       --objectives-of "x=${in}/no_such_field.nii.gz" -o "${o}")
+expect_failure("mesh: objectives without a name" OUTPUTS ${o} FRAGMENTS "NAME=FIELD"
+  ARGS mesh --problem "${WORK}/pre-control" --objectives-of "${in}/fixed.mha" -o "${o}")
+# A problem preprocessed already, preprocessed again: its windowed images would flatten.
+set(o "${WORK}/pre-twice")
+expect_failure("preprocess: a preprocessed problem again" OUTPUTS ${o} FRAGMENTS "windowing them again" "preprocess_intensity_max = 1"
+  ARGS preprocess --problem "${WORK}/pre-control" --set preprocess_rigid_structure=none -o "${o}")
+set(o "${WORK}/mesh-out")
 expect_failure("phantom: unknown case" OUTPUTS "${WORK}/phantom-knee" FRAGMENTS "knee" "bladder-emptying"
   ARGS phantom --case knee -o "${WORK}/phantom-knee")
 

@@ -164,6 +164,28 @@ if(NOT mesh_points EQUAL mesh_expected OR mesh_surface LESS 10 OR mesh_groups LE
   message(FATAL_ERROR "mesh.json: ${mesh_points} points (${mesh_surface} on the bladder surface), "
                       "${mesh_groups} parallel groups:\n${mesh_json}")
 endif()
+# The objectives of known maps on this mesh: the truth matches the contours far
+# better than the identity; the truth's inverse, taken the wrong way round, worse.
+morea_ok("mesh objectives" mesh --problem "${pre}" --set morea_mesh_num_points=200 -o "${WORK}/mesh-objectives"
+  --objectives-of "truth=${phantom}/true_moving_to_fixed.nii.gz" "reversed=${phantom}/true_fixed_to_moving.nii.gz")
+file(READ "${WORK}/mesh-objectives/mesh.json" objectives_json)
+json_number(identity_magnitude "mesh.json" "${objectives_json}" objectives identity magnitude)
+json_number(identity_guidance "mesh.json" "${objectives_json}" objectives identity guidance)
+json_number(truth_magnitude "mesh.json" "${objectives_json}" objectives truth magnitude)
+json_number(truth_guidance "mesh.json" "${objectives_json}" objectives truth guidance)
+json_number(reversed_guidance "mesh.json" "${objectives_json}" objectives reversed guidance)
+if(NOT identity_magnitude EQUAL 0 OR NOT truth_magnitude GREATER 0)
+  message(FATAL_ERROR "mesh objectives: magnitude identity ${identity_magnitude}, truth ${truth_magnitude}:\n"
+                      "${objectives_json}")
+endif()
+if(NOT truth_guidance LESS identity_guidance OR NOT identity_guidance LESS reversed_guidance)
+  message(FATAL_ERROR "mesh objectives: guidance truth ${truth_guidance}, identity ${identity_guidance}, "
+                      "reversed ${reversed_guidance} (expected in this order)")
+endif()
+if(NOT MOREA_STDOUT MATCHES "objectives of truth: magnitude")
+  message(FATAL_ERROR "mesh objectives: nothing printed:\n${MOREA_STDOUT}")
+endif()
+
 file(READ "${meshdir}/mesh_fixed.vtu" vtu LIMIT 400)
 if(NOT vtu MATCHES "UnstructuredGrid")
   message(FATAL_ERROR "mesh_fixed.vtu is not a VTK unstructured grid:\n${vtu}")
