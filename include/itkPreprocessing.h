@@ -84,6 +84,13 @@ Preprocess(const RegistrationProblem & input, const PreprocessOptions & options)
 void
 CheckGuidanceStructuresKept(const PreprocessReport & report, const morea_core::ParameterSet & parameters);
 
+/** Whether both images' values lie in [0, 1], as preprocessing leaves them
+ *  (a problem `morea preprocess` wrote, a registration's preprocessed/
+ *  folder). Preprocess refuses such images under a window of Hounsfield
+ *  units: windowed again they would lose their contrast. */
+bool
+IsWindowedAlready(const RegistrationProblem & problem);
+
 // The steps, usable alone.
 
 /** Resamples `image` onto isotropic voxels of `spacing` mm covering the same extent (linear). */

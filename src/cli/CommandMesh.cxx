@@ -5,7 +5,6 @@
 
 #include "itkMOREAImageIO.h"
 #include "itkMeshModel.h"
-#include "itkMinimumMaximumImageCalculator.h"
 #include "itkObjectiveData.h"
 #include "itkPreprocessing.h"
 #include "itkVectorLinearInterpolateImageFunction.h"
@@ -138,20 +137,11 @@ AddMeshCommand(CLI::App & app)
     for (const auto & entry : options->objectivesOf)
       if (entry.find('=') == std::string::npos || entry.front() == '=' || entry.back() == '=')
         throw morea_core::Error("--objectives-of: expected NAME=FIELD, got '" + entry + "'");
-    if (!options->objectivesOf.empty())
-    {
-      // As a registration scores them: on windowed images (values in [0, 1]).
-      for (const auto * image : { problem.fixedImage.GetPointer(), problem.movingImage.GetPointer() })
-      {
-        auto range = itk::MinimumMaximumImageCalculator<itk::morea::ImageType>::New();
-        range->SetImage(image);
-        range->Compute();
-        if (range->GetMinimum() < 0.0f || range->GetMaximum() > 1.0f)
-          throw morea_core::Error("--objectives-of scores a map as a registration does, on its preprocessed "
-                                  "images: give the problem `morea preprocess` wrote (or a registration's "
-                                  "preprocessed/ folder); these images have values outside [0, 1]");
-      }
-    }
+    // As a registration scores them: on its preprocessed (windowed) images.
+    if (!options->objectivesOf.empty() && !itk::morea::IsWindowedAlready(problem))
+      throw morea_core::Error("--objectives-of scores a map as a registration does, on its preprocessed "
+                              "images: give the problem `morea preprocess` wrote (or a registration's "
+                              "preprocessed/ folder); these images have values outside [0, 1]");
     const auto model = itk::morea::BuildMeshModel(problem, parameters);
     nlohmann::json objectives; // before anything is written: a field may be unreadable
     if (!options->objectivesOf.empty())

@@ -23,6 +23,7 @@
 #include <cmath>
 #include <iterator>
 #include <limits>
+#include <sstream>
 
 namespace itk
 {
@@ -442,34 +443,38 @@ AxisAlignedProblem(const RegistrationProblem & input)
   }
   return out;
 }
-/** Images whose values all lie in [0, 1] (a problem `morea preprocess` or a
- *  run's preprocessed/ folder holds, or images normalised elsewhere) under a
- *  window of Hounsfield units would be squashed into a sliver of it, leaving
+/** Windowing images that are windowed already (IsWindowedAlready) with a
+ *  window of Hounsfield units would squash them into a sliver of it and leave
  *  the intensity objective nearly flat: refused, with what to do instead. */
 void
 FailOnWindowedImages(const RegistrationProblem & problem, const PreprocessOptions & options)
 {
-  constexpr double WidestWindowForUnitImages = 100.0;
-  if (options.windowMax - options.windowMin < WidestWindowForUnitImages)
+  constexpr double NarrowestHounsfieldWindow = 100.0;
+  if (options.windowMax - options.windowMin < NarrowestHounsfieldWindow || !IsWindowedAlready(problem))
     return;
-  for (const auto & [side, image] : { std::pair<const char *, const ImageType *>{ "fixed", problem.fixedImage },
-                                      std::pair<const char *, const ImageType *>{ "moving", problem.movingImage } })
+  std::ostringstream window;
+  window << "[" << options.windowMin << ", " << options.windowMax << "]";
+  Fail("preprocessing: the images' values lie in [0, 1], as in a problem that `morea preprocess` (or a "
+       "registration's preprocessed/ folder) holds, but the intensity window is " + window.str() +
+       ": windowing them again would flatten them. Register the original images (registration preprocesses "
+       "them itself), or set preprocess_intensity_min = 0 and preprocess_intensity_max = 1 for images "
+       "normalised already.");
+}
+} // namespace
+
+bool
+IsWindowedAlready(const RegistrationProblem & problem)
+{
+  for (const ImageType * image : { problem.fixedImage.GetPointer(), problem.movingImage.GetPointer() })
   {
     auto range = MinimumMaximumImageCalculator<ImageType>::New();
     range->SetImage(image);
     range->Compute();
     if (range->GetMinimum() < 0.0f || range->GetMaximum() > 1.0f)
-      return;
-    if (std::string(side) == "moving")
-      Fail("preprocessing: the images' values lie in [0, 1], as in a problem that `morea preprocess` (or a "
-           "registration's preprocessed/ folder) holds, but the intensity window is [" +
-           std::to_string(options.windowMin) + ", " + std::to_string(options.windowMax) +
-           "]: windowing them again would flatten them. Register the original images (registration "
-           "preprocesses them itself), or set preprocess_intensity_min = 0 and preprocess_intensity_max = 1 "
-           "for images normalised already.");
+      return false;
   }
+  return true;
 }
-} // namespace
 
 PreprocessResult
 Preprocess(const RegistrationProblem & given, const PreprocessOptions & options)
