@@ -18,7 +18,8 @@
 #                 problem with the study's parameter file and pre-alignment (backend
 #                 auto: the GPU), the check that its preprocessing is the study's
 #                 problem, `morea evaluate` of the chosen solution (best guidance) on the
-#                 problem, with the landmarks per kind; keeps only scores.json, run.json
+#                 problem, with the landmarks per kind, and of the knee beside it (configuration
+#                 VARIANT-knee: the report's side row "MOREA (knee)", not tested); keeps only scores.json, run.json
 #                 and front.csv per run, plus renders of the first seed. Writes, into
 #                 OUTDIR, study-morea-TAG.tar.gz (the tree to unpack into STUDY/),
 #                 study-morea-TAG.csv (one line per run) and study-morea-TAG.log.
@@ -124,6 +125,28 @@ case "${1:-}" in
     say() { echo "$(date +%T) $*" | tee -a "$log"; }
     pack() { tar czf "$out/study-morea-$tag.tar.gz.tmp" -C "$results" . && mv "$out/study-morea-$tag.tar.gz.tmp" "$out/study-morea-$tag.tar.gz"; }
     jq_() { python3 -c "import json,sys; d=json.load(open(sys.argv[1])); v=eval(sys.argv[2]); print(v if not isinstance(v,(list,dict)) else json.dumps(v))" "$@"; }
+    # score SOLUTION_DIR RUN_DIR SOLUTION CONFIG: scores.json.tmp (with the landmarks per
+    # kind) and run.json of one selected solution of the registration in $reg.
+    score() {
+      local sol=$1 rd=$2 solution=$3 config=$4 parts=() k
+      "$morea" evaluate --problem "$pd/problem" --field "$sol/preprocessed_fixed_to_moving.nii.gz" \
+        --inverse-field "$sol/preprocessed_moving_to_fixed.nii.gz" -o "$rd/scores.main.json" >>"$log" 2>&1
+      for k in $kinds; do
+        "$morea" evaluate --problem "$pd/problem" --field "$sol/preprocessed_fixed_to_moving.nii.gz" \
+          --fixed-landmarks "$pd/landmarks/$k/fixed_landmarks.txt" \
+          --moving-landmarks "$pd/landmarks/$k/moving_landmarks.txt" -o "$rd/scores.$k.json" >>"$log" 2>&1
+        parts+=("$k=$rd/scores.$k.json")
+      done
+      if [ ${#parts[@]} -gt 0 ]; then
+        python3 -m study.landmark_kinds merge "$rd/scores.json.tmp" "$rd/scores.main.json" "${parts[@]}"
+      else
+        cp "$rd/scores.main.json" "$rd/scores.json.tmp"
+      fi
+      rm -f "$rd"/scores.*.json
+      python3 -m study.morea_record record "$reg" "$rd/run.json" --seed "$seed" --config "$config" \
+        --parameters "study/params/$(jq_ "$job" "d['parameters_source']")" --seconds "$seconds" \
+        --host "$host" --extra-args "${extra[*]:-}" --solution "$solution"
+    }
     say "morea: $morea ($("$morea" info 2>/dev/null | head -1 || true)); $host; deadline ${deadline} s"
     last=0
     stop=0
@@ -195,24 +218,13 @@ case "${1:-}" in
             continue
           fi
           sol="$reg/best_guidance"
-          "$morea" evaluate --problem "$pd/problem" --field "$sol/preprocessed_fixed_to_moving.nii.gz" \
-            --inverse-field "$sol/preprocessed_moving_to_fixed.nii.gz" -o "$rd/scores.main.json" >>"$log" 2>&1
-          parts=()
-          for k in $kinds; do
-            "$morea" evaluate --problem "$pd/problem" --field "$sol/preprocessed_fixed_to_moving.nii.gz" \
-              --fixed-landmarks "$pd/landmarks/$k/fixed_landmarks.txt" \
-              --moving-landmarks "$pd/landmarks/$k/moving_landmarks.txt" -o "$rd/scores.$k.json" >>"$log" 2>&1
-            parts+=("$k=$rd/scores.$k.json")
-          done
-          if [ ${#parts[@]} -gt 0 ]; then
-            python3 -m study.landmark_kinds merge "$rd/scores.json.tmp" "$rd/scores.main.json" "${parts[@]}"
-          else
-            cp "$rd/scores.main.json" "$rd/scores.json.tmp"
+          score "$sol" "$rd" best_guidance "$variant$label"
+          if [ -d "$reg/knee" ]; then   # beside the chosen solution: the knee, its own configuration
+            kd="$results/$pair/runs/morea/$variant$label-knee/seed$seed"
+            rm -rf "$kd" && mkdir -p "$kd"
+            score "$reg/knee" "$kd" knee "$variant$label-knee"
+            mv "$kd/scores.json.tmp" "$kd/scores.json"
           fi
-          rm -f "$rd"/scores.*.json
-          python3 -m study.morea_record record "$reg" "$rd/run.json" --seed "$seed" --config "$variant$label" \
-            --parameters "study/params/$(jq_ "$job" "d['parameters_source']")" --seconds "$seconds" \
-            --host "$host" --extra-args "${extra[*]:-}"
           cp "$reg/front.csv" "$rd/"
           if [ "${MOREA_STUDY_FRONT:-0}" = 1 ]; then
             python3 -m study.front_scores "$reg" "$pd/problem" "$rd/front_scores.csv" --morea "$morea" \

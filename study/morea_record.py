@@ -28,11 +28,11 @@ CHOSEN = "best_guidance"
 
 def record(summary: dict, seed: int, parameters: str, config: str, seconds: float,
            total_seconds: float | None = None, host: str | None = None,
-           extra_args: list[str] | None = None) -> dict:
-    chosen = summary["solutions"][CHOSEN]
+           extra_args: list[str] | None = None, solution: str = CHOSEN) -> dict:
+    chosen = summary["solutions"][solution]
     rec = {
         "method": "morea", "seed": seed, "config": config, "parameters": str(parameters),
-        "extra_args": list(extra_args or []), "chosen": CHOSEN,
+        "extra_args": list(extra_args or []), "chosen": solution,
         "chosen_objectives": {k: chosen[k] for k in ("magnitude", "intensity", "guidance", "id")},
         "voxel_fold_repair": chosen.get("voxel_fold_repair"),
         "front_size": summary.get("front_size"), "generations": summary.get("generations"),
@@ -154,6 +154,7 @@ def main(argv=None) -> int:
     r.add_argument("--total-seconds", type=float)
     r.add_argument("--host")
     r.add_argument("--extra-args", default="", help="the variant's extra arguments, one string")
+    r.add_argument("--solution", default=CHOSEN, help="the selected solution scored (default: the study's choice)")
     c = sub.add_parser("check")
     c.add_argument("register", type=Path)
     c.add_argument("problem", type=Path)
@@ -164,7 +165,7 @@ def main(argv=None) -> int:
     if a.command == "record":
         summary = json.loads((a.register / "summary.json").read_text())
         rec = record(summary, a.seed, a.parameters, a.config, a.seconds, a.total_seconds,
-                     a.host, a.extra_args.split() if a.extra_args else [])
+                     a.host, a.extra_args.split() if a.extra_args else [], a.solution)
         a.out.write_text(json.dumps(rec, indent=1, sort_keys=True))
         return 0
     if a.command == "check":

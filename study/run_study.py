@@ -91,6 +91,12 @@ PROFILES = {"reduced": REDUCED, "paper": PAPER, "quick": QUICK}
 ALPHA = 0.025
 CONVERGED_BELOW = 0.01   # relative change of the first criterion at twice the iterations
 DOUBLED = "-x2"          # configuration suffix of the convergence check's runs
+KNEE = "-knee"           # configuration suffix of a MOREA configuration's knee solution
+
+
+def report_side_key(variant: str) -> str:
+    """The report's key of a MOREA configuration's knee (a side row)."""
+    return "morea:knee" if variant == "default" else f"morea:{variant}{KNEE}"
 
 
 def config_name(method: str, weight: float | None, scale: int = 1, variant: str = "default") -> str:
@@ -464,6 +470,8 @@ class Study:
         for m in ("morea", "elastix", "ants"):
             if m == "morea":
                 cfgs = [(m if v == "default" else f"morea:{v}", v) for v in self.pair.morea_variants]
+                # Each configuration's knee, where the GPU script scored it: beside, not tested.
+                cfgs += [(report_side_key(v), f"{v}{KNEE}") for v in self.pair.morea_variants]
             else:
                 if m not in self.settings:
                     continue

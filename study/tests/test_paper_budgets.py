@@ -82,9 +82,15 @@ def test_abdomen_acceptance_against_the_better_competitor(tmp_path, monkeypatch)
         _run(out, "elastix", "w1", seed, _organ_scores((0.70, 9.0), (0.60, 20.0)), {"seconds": {"registration": 1}})
         _run(out, "morea", "default", seed, _organ_scores((0.85, 4.2), (0.80, 15.0), jac=0.0 if seed == 1 else 1e-6),
              {"seconds": {"registration": 1}})
+        # The knee, scored beside the chosen solution by the GPU script: a side row, no checks.
+        _run(out, "morea", "default-knee", seed, _organ_scores((0.5, 20.0), (0.5, 30.0), jac=0.5),
+             {"seconds": {"registration": 1}, "chosen": "knee"})
     study.settings["ants"]["weights"] = [0.0]
     study.settings["elastix"]["weights"] = [1.0]
     chosen = study.chosen_rows(study.collect())
+    assert chosen["morea:knee"][0] == "default-knee" and len(chosen["morea:knee"][1]) == 2
+    assert report.method_label("morea:knee") == "MOREA (knee)"
+    assert [t["comparison"].split(" vs ")[0] for t in report.mann_whitney(chosen, study.pair)] == ["MOREA"] * 4
     checks = {c["check"]: c for c in report.acceptance(study.pair, chosen)}
     assert set(checks) == {"stomach Dice >= the better competitor (ANTs SyN)",
                            "stomach HD95 <= the better competitor (ANTs SyN)",
@@ -98,3 +104,13 @@ def test_abdomen_acceptance_against_the_better_competitor(tmp_path, monkeypatch)
     assert not checks["no voxel with Jacobian <= 0, worst seed"]["passed"]
     # The first study's pair (MOREA on the CPU, reduced budgets) has no such checks.
     assert report.acceptance(pairs.make("abdomen", False), chosen) == []
+
+
+def test_a_knee_is_recorded_as_the_knee():
+    from study import morea_record
+    solutions = {name: {"magnitude": m, "intensity": 0.1, "guidance": g, "id": i}
+                 for name, m, g, i in (("best_guidance", 3.0, 0.2, 7), ("knee", 1.0, 0.3, 9))}
+    summary = {"solutions": solutions, "seconds": {"command": 30.0}}
+    rec = morea_record.record(summary, 2, "p.toml", "default-knee", 31.0, solution="knee")
+    assert rec["chosen"] == "knee" and rec["chosen_objectives"]["id"] == 9
+    assert morea_record.record(summary, 2, "p.toml", "default", 31.0)["chosen_objectives"]["id"] == 7
