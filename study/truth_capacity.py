@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .contour_capacity import locate, read_vtu, signed_volumes
+from .contour_capacity import carry, read_vtu, signed_volumes
 
 
 def read_points(path):
@@ -43,9 +43,7 @@ def field_map(path):
 def carried_tre(source, target, tetrahedra, fixed_landmarks, moving_landmarks):
     """TRE of the piecewise-affine map target -> source at the fixed landmarks
     inside the target mesh: (errors in mm, how many lay inside)."""
-    where, weights = locate(fixed_landmarks, target, tetrahedra)
-    inside = where >= 0
-    mapped = np.einsum("pk,pkj->pj", weights[inside], source[tetrahedra[where[inside]]])
+    mapped, inside = carry(fixed_landmarks, target, source, tetrahedra)
     return np.linalg.norm(mapped - moving_landmarks[inside], axis=1), int(inside.sum())
 
 

@@ -143,6 +143,7 @@ AddMeshCommand(CLI::App & app)
                               "images: give the problem `morea preprocess` wrote (or a registration's "
                               "preprocessed/ folder); these images have values outside [0, 1]");
     const auto model = itk::morea::BuildMeshModel(problem, parameters);
+    const auto base = morea_core::DualMesh::FromBase(model.base);
     nlohmann::json objectives; // before anything is written: a field may be unreadable
     if (!options->objectivesOf.empty())
     {
@@ -152,7 +153,7 @@ AddMeshCommand(CLI::App & app)
       const morea_core::TetrahedronEvaluator evaluator(model.topology, constraint, model.elasticity, model.rigidity,
                                                        data);
       const std::size_t tetrahedra = model.base.NumberOfTetrahedra();
-      objectives["identity"] = ObjectivesToJson(evaluator, morea_core::DualMesh::FromBase(model.base), tetrahedra);
+      objectives["identity"] = ObjectivesToJson(evaluator, base, tetrahedra);
       for (const auto & entry : options->objectivesOf)
       {
         const std::string name = entry.substr(0, entry.find('='));
@@ -166,7 +167,6 @@ AddMeshCommand(CLI::App & app)
     }
     std::filesystem::create_directories(options->output);
     const std::string out = options->output + "/";
-    const auto        base = morea_core::DualMesh::FromBase(model.base);
     itk::morea::WriteSolutionMeshes(model, base, out + "mesh_moving.vtu", out + "mesh_fixed.vtu");
 
     nlohmann::json report = ReportToJson(model);
