@@ -37,9 +37,16 @@ def test_paper_budget_pairs_register_the_first_studys_problem(name):
                 "morea_sampling_rate"):
         assert p[key] == paper[key], key
     assert p["morea_mesh_surface_structures"] == small["morea_mesh_surface_structures"]
+    # The study's MOREA is the paper's configuration, steering included; the
+    # tighter steering is a side row, and only that key differs there.
     assert pair.morea_variants["default"] == []
+    assert p.get("ea_adaptive_steering_guidance_threshold", 1.5) == 1.5
+    steering = ["--set", "ea_adaptive_steering_guidance_threshold=1.1"]
+    assert pair.morea_variants["steering-1.1"] == steering
     if name == "abdomen-paper":
-        assert pair.morea_variants["1000-generations"] == ["--set", "ea_num_generations=1000"]
+        longer = ["--set", "ea_num_generations=1000"]
+        assert pair.morea_variants["1000-generations"] == longer
+        assert pair.morea_variants["1000-generations-steering-1.1"] == longer + steering
 
 
 def test_job_carries_a_data_pairs_files(tmp_path, monkeypatch):
