@@ -38,8 +38,10 @@
 #                                run 10 minutes); what is left is for another call
 #   MOREA_STUDY_TAG=NAME         names the outputs (default: the pairs and seeds)
 #   MOREA_STUDY_KEEP_FIELDS=1    also keep both fields of the first seed (a few MB each)
-#   MOREA_STUDY_FRONT=1          write every front member and score each (study/front_scores.py):
-#                                front_scores.csv per run, TRE and Dice along the whole front
+#   MOREA_STUDY_FRONT=N          also write N members spread over the front (--select spread:N)
+#                                and score each (study/front_scores.py): front_scores.csv per
+#                                run, TRE and Dice along the front; "all" for every member
+#                                (slow: a paper-scale front holds 500-1700)
 #   MOREA_STUDY_SET="K=V ..."    an experiment outside the study: these overrides on every run,
 #   MOREA_STUDY_LABEL=NAME       whose results go to configuration VARIANT-NAME (required with
 #                                MOREA_STUDY_SET, so that they never mix with the study's runs)
@@ -92,6 +94,14 @@ case "${1:-}" in
     if [ -n "${MOREA_STUDY_SET:-}" ] && [ -z "$label" ]; then
       echo "MOREA_STUDY_SET needs MOREA_STUDY_LABEL (an experiment's runs are kept apart)" >&2; exit 2
     fi
+    select=best-guidance,knee
+    front=${MOREA_STUDY_FRONT:-0}
+    case "$front" in
+      0) ;;
+      all) select=$select,all ;;
+      ''|*[!0-9]*) echo "MOREA_STUDY_FRONT=$front: a number of solutions, or all" >&2; exit 2 ;;
+      *) select=$select,spread:$front ;;
+    esac
     mkdir -p "$out"
     out=$(cd "$out" && pwd)
     t0=$(date +%s)
@@ -110,8 +120,6 @@ case "${1:-}" in
     results="$work/results"
     mkdir -p "$results" "$work/raw" "$work/reg"
     deadline=${MOREA_STUDY_DEADLINE_S:-540}
-    select=best-guidance,knee
-    [ "${MOREA_STUDY_FRONT:-0}" = 1 ] && select=best-guidance,knee,all
     pairs_sel=${MOREA_STUDY_PAIRS:-}
     if [ -z "$pairs_sel" ]; then
       for j in "$bundle"/data/*/morea_job.json; do pairs_sel="$pairs_sel $(basename "$(dirname "$j")")"; done
@@ -226,7 +234,7 @@ case "${1:-}" in
             mv "$kd/scores.json.tmp" "$kd/scores.json"
           fi
           cp "$reg/front.csv" "$rd/"
-          if [ "${MOREA_STUDY_FRONT:-0}" = 1 ]; then
+          if [ "$front" != 0 ]; then
             python3 -m study.front_scores "$reg" "$pd/problem" "$rd/front_scores.csv" --morea "$morea" \
               ${kinds:+--landmarks "$pd/landmarks"} 2>>"$log" || say "  front scores failed (see the log)"
           fi

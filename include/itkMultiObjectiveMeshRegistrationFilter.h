@@ -43,7 +43,7 @@ namespace itk
  * optional rigid pre-alignment on a structure, cropping, intensity window),
  * MOREA runs on the preprocessed images, and the solutions named by the
  * selection ("best-guidance", "knee", "weighted:a:b:c", "nearest:m:i:g",
- * "all"; comma-separated) are rasterised into displacement field transforms.
+ * "spread:N", "all"; comma-separated) are rasterised into displacement field transforms.
  *
  * Where it runs: SetBackend("auto") (the default) evaluates on the GPU's
  * texture path when a usable CUDA device is present and on the CPU
@@ -248,7 +248,8 @@ public:
   itkBooleanMacro(Resume);
   /** Which solutions get transform outputs (comma-separated): best-guidance,
    *  knee, weighted:a:b:c (weights of the normalised objectives), nearest:m:i:g
-   *  (objective values), all. Default "best-guidance". */
+   *  (objective values), spread:N (N solutions spread over the front, best
+   *  guidance first), all. Default "best-guidance". */
   itkSetMacro(Selection, std::string);
   itkGetConstReferenceMacro(Selection, std::string);
 

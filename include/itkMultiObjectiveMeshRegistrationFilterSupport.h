@@ -61,7 +61,7 @@ struct SolutionChoice
 };
 
 /** Throws morea_core::Error unless `selection` is a comma-separated list of
- *  best-guidance, knee, weighted:a:b:c, nearest:m:i:g and all, with at least one item. */
+ *  best-guidance, knee, weighted:a:b:c, nearest:m:i:g, spread:N and all, with at least one item. */
 void
 CheckSolutionSelection(const std::string & selection);
 

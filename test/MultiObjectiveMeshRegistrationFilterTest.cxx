@@ -11,6 +11,7 @@
 #include "itkResampleImageFilter.h"
 #include "itkTransformFileReader.h"
 #include "morea_core/ComputeDevices.h"
+#include "morea_core/Error.h"
 #include "morea_core/ParetoFront.h"
 
 #include <gtest/gtest.h>
@@ -313,6 +314,28 @@ TEST(MultiObjectiveMeshRegistrationFilter, BadInputsThrowITKExceptions)
     EXPECT_THROW(filter->Update(), itk::ExceptionObject);
     EXPECT_EQ(filter->GetNumberOfSelectedSolutions(), 0u);
   }
+}
+
+TEST(MultiObjectiveMeshRegistrationFilter, SpreadSelectionsNameFewDistinctSolutionsById)
+{
+  itk::morea::ApproximationSet set;
+  for (std::uint64_t id = 0; id < 50; ++id)
+  {
+    const double t = static_cast<double>(id) / 49.0; // a line from guidance 0 to magnitude 0
+    set.push_back({ 100 + id, { { 1.0 - t, 0.5, t } }, 0.0 });
+  }
+  const auto chosen = itk::morea::SelectSolutions(set, "best-guidance,spread:3,spread:3");
+  // Best guidance (id 100) under its own label and again as the spread's
+  // first; then the far end and the middle (ids 124 and 125 tie: the first);
+  // a repeat adds nothing.
+  std::vector<std::string> labels;
+  for (const auto & c : chosen)
+    labels.push_back(c.label);
+  EXPECT_EQ(labels, (std::vector<std::string>{ "best_guidance", "solution_100", "solution_149", "solution_124" }));
+  EXPECT_EQ(itk::morea::SelectSolutions(set, "spread:500").size(), set.size());
+  for (const char * bad : { "spread:0", "spread:", "spread:-2", "spread:2x", "spread: 2", "spread:1.5" })
+    EXPECT_THROW(itk::morea::CheckSolutionSelection(bad), morea_core::Error) << bad;
+  EXPECT_NO_THROW(itk::morea::CheckSolutionSelection("knee,spread:12"));
 }
 
 TEST(MultiObjectiveMeshRegistrationFilter, AbortsAfterTheGenerationAnObserverStopsAt)

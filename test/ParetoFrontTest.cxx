@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <set>
 #include <vector>
 
 namespace
@@ -385,4 +386,37 @@ TEST(ParetoFront, SelectNearest)
   EXPECT_EQ(morea_core::SelectNearest(scaled, { { 60, 1, 0 } }), 0u);
   EXPECT_EQ(morea_core::SelectNearest(scaled, { { 80, 0.2, 0 } }), 1u);
   EXPECT_THROW(morea_core::SelectNearest({}, { { 0, 0, 0 } }), morea_core::Error);
+}
+
+TEST(ParetoFront, SelectSpread)
+{
+  // Normalised, the front spans the unit cube's corners and one middle point.
+  const std::vector<ObjectiveVector> front{ { { 0.5, 0.5, 0.5 } }, { { 1, 0, 0 } }, { { 0, 1, 0 } },
+                                            { { 0, 0, 1 } },       { { 0.9, 0.1, 0.0 } } };
+  // Best guidance first, then each time the farthest from those chosen:
+  // corners 1, 2, 3, the middle, and last the near-copy of corner 1.
+  const auto four = morea_core::SelectSpread(front, 4);
+  ASSERT_EQ(four, (std::vector<std::size_t>{ 1, 2, 3, 0 }));
+  EXPECT_EQ(four[0], morea_core::SelectBestGuidance(front));
+  // Distinct, and every prefix is what a smaller count gives.
+  EXPECT_EQ(std::set<std::size_t>(four.begin(), four.end()).size(), 4u);
+  for (std::size_t n = 1; n <= 4; ++n)
+    EXPECT_EQ(morea_core::SelectSpread(front, n), std::vector<std::size_t>(four.begin(), four.begin() + n)) << n;
+  // The second is the member farthest from the first.
+  const auto distance = [&](std::size_t a, std::size_t b) {
+    double d = 0.0;
+    for (std::size_t j = 0; j < 3; ++j)
+      d += (front[a][j] - front[b][j]) * (front[a][j] - front[b][j]);
+    return d;
+  };
+  for (std::size_t i = 0; i < front.size(); ++i)
+    EXPECT_LE(distance(i, four[0]), distance(four[1], four[0]));
+  // The near-duplicate of a chosen corner (index 4) comes last.
+  const auto all = morea_core::SelectSpread(front, 10);
+  ASSERT_EQ(all.size(), front.size());
+  EXPECT_EQ(all.back(), 4u);
+  // Equal solutions are not chosen twice.
+  EXPECT_EQ(morea_core::SelectSpread({ { { 1, 2, 3 } }, { { 1, 2, 3 } } }, 5), std::vector<std::size_t>{ 0 });
+  EXPECT_THROW(morea_core::SelectSpread(front, 0), morea_core::Error);
+  EXPECT_THROW(morea_core::SelectSpread({}, 3), morea_core::Error);
 }

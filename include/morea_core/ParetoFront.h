@@ -105,6 +105,12 @@ SelectWeighted(const std::vector<ObjectiveVector> & front, const ObjectiveVector
 /** Nearest to `point` (raw objective units, normalised like the front). */
 std::size_t
 SelectNearest(const std::vector<ObjectiveVector> & front, const ObjectiveVector & point);
+/** Up to `count` distinct solutions spread over the front, in the order
+ *  chosen: the best-guidance solution first, then each time the one farthest
+ *  (normalised) from all chosen so far, the first on ties; so every prefix is
+ *  spread too. Fewer when the front holds fewer; count 0 throws. */
+std::vector<std::size_t>
+SelectSpread(const std::vector<ObjectiveVector> & front, std::size_t count);
 } // namespace morea_core
 
 #endif

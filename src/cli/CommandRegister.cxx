@@ -150,7 +150,7 @@ AddRegisterCommand(CLI::App & app)
   options->parameters.AddTo(*cmd);
   cmd->add_option("-o,--output", options->output, "output folder")->required();
   cmd->add_option("--select", options->select,
-                  "solutions to write: best-guidance, knee, weighted:a:b:c, nearest:m:i:g, all (comma-separated)")
+                  "solutions to write: best-guidance, knee, weighted:a:b:c, nearest:m:i:g, spread:N (N solutions spread over the front), all (comma-separated)")
     ->capture_default_str();
   cmd->add_option("--checkpoint-every", options->checkpointEvery,
                   "write output/checkpoint.bin every N generations (10), every so long (30s, 5min: at the first "

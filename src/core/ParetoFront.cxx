@@ -409,4 +409,28 @@ SelectNearest(const std::vector<ObjectiveVector> & front, const ObjectiveVector 
   const ObjectiveVector target = normalise(point);
   return ArgMin(front.size(), [&](std::size_t i) { return SquaredDistance(normalise(front[i]), target); });
 }
+
+std::vector<std::size_t>
+SelectSpread(const std::vector<ObjectiveVector> & front, std::size_t count)
+{
+  RequireNonEmpty(front, "spread selection");
+  if (count == 0)
+    throw Error("spread selection: the number of solutions must be at least 1");
+  const auto               normalised = Normalised(front);
+  std::vector<std::size_t> chosen{ SelectBestGuidance(front) };
+  // Each solution's distance to the nearest chosen one, updated per choice.
+  std::vector<double> nearest(front.size());
+  for (std::size_t i = 0; i < front.size(); ++i)
+    nearest[i] = SquaredDistance(normalised[i], normalised[chosen[0]]);
+  while (chosen.size() < count)
+  {
+    const std::size_t next = ArgMin(front.size(), [&](std::size_t i) { return -nearest[i]; });
+    if (nearest[next] <= 0.0)
+      break; // every solution left equals a chosen one
+    chosen.push_back(next);
+    for (std::size_t i = 0; i < front.size(); ++i)
+      nearest[i] = std::min(nearest[i], SquaredDistance(normalised[i], normalised[next]));
+  }
+  return chosen;
+}
 } // namespace morea_core

@@ -19,7 +19,7 @@ namespace morea
 {
 namespace
 {
-const char * const SelectionHelp = "best-guidance, knee, weighted:a:b:c, nearest:m:i:g, all";
+const char * const SelectionHelp = "best-guidance, knee, weighted:a:b:c, nearest:m:i:g, spread:N, all";
 
 morea_core::ObjectiveVector
 ParseTriple(const std::string & item, const std::string & text)
@@ -46,6 +46,16 @@ ParseTriple(const std::string & item, const std::string & text)
     throw morea_core::Error("selection: '" + item + "' needs three numbers (magnitude:intensity:guidance)");
   }
   return v;
+}
+
+std::size_t
+ParseCount(const std::string & item, const std::string & text)
+{
+  // Digits only: stoul would take "-1" or " 3".
+  if (text.empty() || text.size() > 9 || !std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; }) ||
+      std::stoul(text) == 0)
+    throw morea_core::Error("selection: '" + item + "' needs a whole number of solutions, at least 1 (spread:N)");
+  return std::stoul(text);
 }
 
 /** Walks the selection; `add` gets each choice. With an empty `objectives`
@@ -85,6 +95,13 @@ ForEachChoice(const std::string & selection, const std::vector<morea_core::Objec
       const auto point = ParseTriple(item, item.substr(8));
       if (!check)
         add("nearest", morea_core::SelectNearest(objectives, point));
+    }
+    else if (item.rfind("spread:", 0) == 0)
+    {
+      const std::size_t count = ParseCount(item, item.substr(7));
+      if (!check)
+        for (std::size_t index : morea_core::SelectSpread(objectives, count))
+          add({}, index); // labelled by the caller, as with "all"
     }
     else
       throw morea_core::Error("selection: unknown choice '" + item + "' (" + SelectionHelp + ")");

@@ -306,3 +306,18 @@ def test_gpu_script_keeps_experiments_apart(tmp_path):
     assert done.returncode == 2
     assert "MOREA_STUDY_LABEL" in done.stderr
     assert not (tmp_path / "work").exists() and not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("front", ["some", "-3", "2x"])
+def test_gpu_script_refuses_a_bad_front_count(tmp_path, front):
+    """MOREA_STUDY_FRONT is a number of solutions spread over the front or
+    "all"; anything else is refused before anything runs."""
+    import os
+    import subprocess
+    script = common.REPO_ROOT / "bench" / "run-study-morea.sh"
+    env = dict(os.environ, MOREA_BIN="/bin/true", MOREA_STUDY_WORK=str(tmp_path / "work"), MOREA_STUDY_FRONT=front)
+    done = subprocess.run(["bash", str(script), "run", str(tmp_path / "out")], env=env,
+                          capture_output=True, text=True)
+    assert done.returncode == 2
+    assert "MOREA_STUDY_FRONT" in done.stderr
+    assert not (tmp_path / "work").exists() and not (tmp_path / "out").exists()

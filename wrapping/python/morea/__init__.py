@@ -72,7 +72,7 @@ def register(fixed, moving, structures=None, points=None, landmarks=None, parame
     parameters: a TOML parameter file's path, or a dict of its keys.
     backend: "auto" (the GPU when present, else the CPU), "cuda", "cuda-exact", "cpu".
     select: the solutions to rasterise at once (best-guidance, knee,
-        weighted:a:b:c, nearest:m:i:g, all; comma-separated); any other later
+        weighted:a:b:c, nearest:m:i:g, spread:N, all; comma-separated); any other later
         with result.choose().
     checkpoint: a file to write the optimiser's state to, every
         `checkpoint_every`: a number of generations (10) or a duration ("30s",

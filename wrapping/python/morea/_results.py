@@ -170,14 +170,20 @@ class RegistrationResult:
     def choose(self, weights=None, nearest=None, selection=None):
         """Any solution of the front: by weights of the normalised objectives
         (magnitude, intensity, guidance), by the objective values it should be
-        nearest to, or by a selection string ("knee", "best-guidance", ...)."""
+        nearest to, or by a selection string that names one solution ("knee",
+        "best-guidance", ...; "spread:N" and "all" name several: give them to
+        register's `select`)."""
         if sum(x is not None for x in (weights, nearest, selection)) != 1:
             raise ValueError("choose: give exactly one of weights, nearest or selection")
         if weights is not None:
             selection = "weighted:" + ":".join(str(float(w)) for w in weights)
         elif nearest is not None:
             selection = "nearest:" + ":".join(str(float(v)) for v in nearest)
-        label, index = self._registration.choose(selection)[0]
+        chosen = self._registration.choose(selection)
+        if len(chosen) != 1:
+            raise ValueError(f"choose: '{selection}' names {len(chosen)} solutions, not one; "
+                             "pass it as register(select=...) for several")
+        label, index = chosen[0]
         return Solution(self, index, label)
 
     def save(self, folder, solutions=None):

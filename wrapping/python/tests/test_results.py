@@ -48,6 +48,11 @@ def test_save_writes_the_folder_of_morea_register_with_any_solution(result, tmp_
     assert np.allclose(written.TransformPoint(p), knee.fixed_to_moving.TransformPoint(p), atol=1e-6)
     with pytest.raises(ValueError, match="label"):
         result.save(tmp_path / "twice", solutions=[knee, knee])
+    # choose() gives one solution; a selection of several is refused, not cut short.
+    assert result.choose(selection="spread:1").index == result.solutions[0].index
+    if len(result.front) > 1:
+        with pytest.raises(ValueError, match="spread:2"):
+            result.choose(selection="spread:2")
 
 
 def test_resampling_through_the_transforms_reproduces_the_reported_dice(phantom, result):
