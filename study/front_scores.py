@@ -1,6 +1,6 @@
 # Copyright 2026 The MultiObjectiveRegistration authors
 # SPDX-License-Identifier: Apache-2.0
-"""Scores of every solution of a MOREA front (standard library only, so that
+"""Scores of the solutions of a MOREA front (standard library only, so that
 bench/run-study-morea.sh can use it on a GPU machine without the study's packages).
 
 A registration written with `morea register --select all` has one folder
@@ -57,13 +57,15 @@ def score_solution(morea: str, problem: Path, solution: Path, kinds: dict, scrat
 
 def front_scores(register: Path, problem: Path, morea: str, landmarks: Path | None = None,
                  jobs: int = 4) -> list[dict]:
-    """Rows sorted by guidance (best first): front.csv's columns plus the scores."""
+    """Rows sorted by guidance (best first): front.csv's columns plus the
+    scores, for each member written as solution_<id> (`--select all`: the
+    whole front; `--select spread:N`: N members spread over it)."""
     with open(register / "front.csv", newline="") as f:
         front = list(csv.DictReader(f))
-    missing = [r["id"] for r in front if not (register / f"solution_{r['id']}").is_dir()]
-    if missing:
-        raise FileNotFoundError(f"{register}: {len(missing)} front members have no solution folder "
-                                f"(register with --select all), e.g. solution_{missing[0]}")
+    front = [r for r in front if (register / f"solution_{r['id']}").is_dir()]
+    if not front:
+        raise FileNotFoundError(f"{register}: no front member has a solution folder "
+                                "(register with --select all or --select spread:N)")
     kinds = landmark_sets(landmarks) if landmarks else {}
     with tempfile.TemporaryDirectory() as tmp, ThreadPoolExecutor(max_workers=jobs) as pool:
         scored = pool.map(lambda r: score_solution(morea, problem, register / f"solution_{r['id']}",

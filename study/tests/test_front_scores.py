@@ -1,6 +1,6 @@
 # Copyright 2026 The MultiObjectiveRegistration authors
 # SPDX-License-Identifier: Apache-2.0
-"""study/front_scores.py: every front member of a small registration scored,
+"""study/front_scores.py: the front members of a small registration scored,
 one row each, in guidance order, matching `morea evaluate` of that member."""
 from __future__ import annotations
 
@@ -52,5 +52,19 @@ def test_a_front_written_without_its_members_is_refused(morea, registered, tmp_p
     partial = tmp_path / "partial"
     partial.mkdir()
     (partial / "front.csv").write_text((registered / "front.csv").read_text())
-    with pytest.raises(FileNotFoundError, match="--select all"):
+    with pytest.raises(FileNotFoundError, match="--select all or --select spread:N"):
         front_scores.front_scores(partial, registered / "preprocessed", morea)
+
+
+def test_only_the_members_written_are_scored(morea, registered, tmp_path):
+    """A front written with --select spread:N has N solution folders: those are scored."""
+    partial = tmp_path / "partial"
+    partial.mkdir()
+    (partial / "front.csv").write_text((registered / "front.csv").read_text())
+    with open(registered / "front.csv", newline="") as f:
+        ids = [r["id"] for r in csv.DictReader(f)][:2]
+    for i in ids:
+        (partial / f"solution_{i}").symlink_to(registered / f"solution_{i}")
+    rows = front_scores.front_scores(partial, registered / "preprocessed", morea, jobs=2)
+    assert sorted(r["id"] for r in rows) == sorted(ids)
+    assert all(r["dice:ball"] is not None for r in rows)
