@@ -4,7 +4,8 @@
 bench/run-study-morea.sh can use it on a GPU machine without the study's packages).
 
 A registration written with `morea register --select all` has one folder
-solution_<id> per front member. Each is scored on the study problem by
+solution_<id> per front member (`--select spread:N`: N members spread over
+the front). Each is scored on the study problem by
 `morea evaluate` (all landmarks, then each landmark kind), several at a time,
 and the scores go into one CSV row per solution with its objective values from
 front.csv: how TRE and Dice vary along the front, so that a rule choosing a

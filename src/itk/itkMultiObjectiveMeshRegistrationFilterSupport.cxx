@@ -51,11 +51,13 @@ ParseTriple(const std::string & item, const std::string & text)
 std::size_t
 ParseCount(const std::string & item, const std::string & text)
 {
-  // Digits only: stoul would take "-1" or " 3".
-  if (text.empty() || text.size() > 9 || !std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; }) ||
-      std::stoul(text) == 0)
+  // Digits only (stoul would take "-1" or " 3"), at most 9 of them (no overflow).
+  const bool digits =
+    !text.empty() && text.size() <= 9 && std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; });
+  const std::size_t count = digits ? std::stoul(text) : 0;
+  if (count == 0)
     throw morea_core::Error("selection: '" + item + "' needs a whole number of solutions, at least 1 (spread:N)");
-  return std::stoul(text);
+  return count;
 }
 
 /** Walks the selection; `add` gets each choice. With an empty `objectives`
