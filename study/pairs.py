@@ -80,6 +80,10 @@ def make(name: str, quick: bool) -> Pair:
         # (bench/results/comparison-paper-budgets.md).
         steering = ["--set", "ea_adaptive_steering_guidance_threshold=1.1"]
         pair.morea_variants = {"default": [], "steering-1.1": steering}
+        if pair.data_pair == "lung":
+            # Steering cuts the front where ANTs's map lies in MOREA's
+            # objective space (bench/results/comparison-paper-budgets.md).
+            pair.morea_variants["no-steering"] = ["--set", "ea_adaptive_steering_enabled=false"]
         if pair.data_pair == "abdomen":
             # 500 generations are not converged on this pair
             # (bench/results/generation-budget.md).

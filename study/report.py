@@ -163,12 +163,20 @@ def parallel_coordinates(path: Path, chosen: dict, baseline: dict | None, pair,
     for j, c in enumerate(cols):
         if not c.startswith("dice:"):
             norm[:, j] = 1.0 - norm[:, j]
+    # Side rows (other configurations, knees) get colours of their own, in
+    # the order they come; knees are dotted, the baseline dashed and grey.
+    others = iter(["tab:orange", "tab:purple", "tab:brown", "tab:pink", "tab:olive", "tab:cyan"] * 4)
+    for m, _ in series:
+        if m == "rigid baseline":
+            colors.setdefault(m, "tab:gray")
+        elif m not in colors:
+            colors[m] = next(others)
     fig, ax = plt.subplots(figsize=(1.6 * len(cols) + 2, 3.6), dpi=80)
     seen = set()
     for (m, _), y in zip(series, norm):
         label = method_label(m)
-        ax.plot(range(len(cols)), y, color=colors.get(m, "tab:orange"),
-                ls="--" if m == "rigid baseline" else "-", alpha=0.8, marker="o", ms=3,
+        style = "--" if m == "rigid baseline" else (":" if m.endswith("knee") else "-")
+        ax.plot(range(len(cols)), y, color=colors[m], ls=style, alpha=0.8, marker="o", ms=3,
                 label=None if label in seen else label)
         seen.add(label)
     ax.set_xticks(range(len(cols)))

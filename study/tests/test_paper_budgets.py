@@ -47,6 +47,12 @@ def test_paper_budget_pairs_register_the_first_studys_problem(name):
         longer = ["--set", "ea_num_generations=1000"]
         assert pair.morea_variants["1000-generations"] == longer
         assert pair.morea_variants["1000-generations-steering-1.1"] == longer + steering
+    # Steering off is a side row of the lung pair only, and only that key differs.
+    if name == "lung-paper":
+        assert pair.morea_variants["no-steering"] == ["--set", "ea_adaptive_steering_enabled=false"]
+    else:
+        assert "no-steering" not in pair.morea_variants
+    assert p.get("ea_adaptive_steering_enabled", True) is True
 
 
 def test_job_carries_a_data_pairs_files(tmp_path, monkeypatch):
