@@ -16,9 +16,9 @@ cd "$(dirname "$0")/.."
 DATA=${MOREA_DATA:-../shared/data/abdomen-cbct-pair}
 # Mesh level schedules by name: 1 (one mesh), 3 (600 points for 200
 # generations, ~1400 for 200, ~3200 for 100), 2a (600 for 400, ~1400 for
-# 100), 2b (600 for 450, ~3200 for 50), 2c (600 for 475, ~3200 for 25); a trailing g (3g, 2g, 2bg) makes the
-# refined levels' FOS elements groups of points (morea_fos_type =
-# coarse-groups); 2g: 600 for 250, ~3200 for 250.
+# 100), 2b (600 for 450, ~3200 for 50), 2c (600 for 475, ~3200 for 25); a
+# trailing g (3g, 2g, 2bg) makes the refined levels' FOS elements groups of
+# points (morea_fos_type = coarse-groups); 2g: 600 for 250, ~3200 for 250.
 schedule() {
   case "$1" in
     *g) echo "$(schedule "${1%g}") morea_fos_type=coarse-groups"; return ;;

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import csv
+import itertools
 import math
 import platform
 from pathlib import Path
@@ -148,7 +149,7 @@ def parallel_coordinates(path: Path, chosen: dict, baseline: dict | None, pair,
     if not cols:
         return
     series = []
-    colors = {"morea": "tab:red", "elastix": "tab:blue", "ants": "tab:green"}
+    colors = {"morea": "tab:red", "elastix": "tab:blue", "ants": "tab:green", "rigid baseline": "tab:gray"}
     for m in method_keys(chosen):
         cfg, rs = chosen[m]
         for r in rs:
@@ -164,12 +165,10 @@ def parallel_coordinates(path: Path, chosen: dict, baseline: dict | None, pair,
         if not c.startswith("dice:"):
             norm[:, j] = 1.0 - norm[:, j]
     # Side rows (other configurations, knees) get colours of their own, in
-    # the order they come; knees are dotted, the baseline dashed and grey.
-    others = iter(["tab:orange", "tab:purple", "tab:brown", "tab:pink", "tab:olive", "tab:cyan"] * 4)
+    # the order they come; knees are dotted, the baseline dashed.
+    others = itertools.cycle(["tab:orange", "tab:purple", "tab:brown", "tab:pink", "tab:olive", "tab:cyan"])
     for m, _ in series:
-        if m == "rigid baseline":
-            colors.setdefault(m, "tab:gray")
-        elif m not in colors:
+        if m not in colors:
             colors[m] = next(others)
     fig, ax = plt.subplots(figsize=(1.6 * len(cols) + 2, 3.6), dpi=80)
     seen = set()
