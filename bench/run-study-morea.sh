@@ -107,10 +107,16 @@ case "${1:-}" in
     t0=$(date +%s)
     bundle=${MOREA_BUNDLE_DIR:-/tmp/b}
     if [ -z "${MOREA_BIN:-}" ]; then
-      if [ ! -x "$bundle/bin/morea" ]; then
-        mkdir -p "$bundle"
-        tar xJf device-carry/study-morea.tar.xz -C "$bundle"
-      fi
+      # Calls side by side share the bundle: one unpacks it (whole, then
+      # renamed into place) while the others wait for the lock.
+      (
+        flock 9
+        if [ ! -x "$bundle/bin/morea" ]; then
+          rm -rf "$bundle.part" && mkdir -p "$bundle.part"
+          tar xJf device-carry/study-morea.tar.xz -C "$bundle.part"
+          rm -rf "$bundle" && mv -T "$bundle.part" "$bundle"
+        fi
+      ) 9> "$bundle.lock"
       export LD_LIBRARY_PATH="$bundle/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
       morea="$bundle/bin/morea"
     else
