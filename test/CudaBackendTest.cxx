@@ -500,43 +500,6 @@ TEST(CudaEvaluationBackend, RefusalBoundsChangeNoDecision)
   }
 }
 
-// The smoothness term (here without rigid structures: their weights are 0)
-// adds to the magnitude on the device as on the CPU, on both paths.
-TEST(CudaEvaluationBackend, TheSmoothnessTermAgreesWithTheCpu)
-{
-  MOREA_REQUIRE_CUDA_DEVICE();
-  OptimiserTestProblem problem;
-  GomeaOptions         options = problem.Options(9);
-  options.populationSize = 4;
-  const auto population = problem.InitialPopulation(options);
-  double     plain = 0.0;
-  for (const auto & v : EvaluateAll(*CreateCpuEvaluationBackend(*problem.evaluator, 2), population)[1])
-    plain += v.magnitude;
-  problem.UseRigidSlab(0.0, 0.0, 1.0);
-  auto       cpu = CreateCpuEvaluationBackend(*problem.evaluator, 2);
-  const auto a = EvaluateAll(*cpu, population);
-  double     smooth = 0.0;
-  for (const auto & v : a[1])
-    smooth += v.magnitude;
-  EXPECT_GT(smooth, 1.1 * plain) << "the smoothness term should weigh in the test";
-  for (const CudaInterpolation interpolation : { CudaInterpolation::Exact, CudaInterpolation::Texture })
-  {
-    auto       cuda = CreateCudaEvaluationBackend(*problem.evaluator, 2, interpolation);
-    const auto b = EvaluateAll(*cuda, population);
-    for (std::size_t s = 0; s < population.size(); ++s)
-      for (std::size_t t = 0; t < a[s].size(); ++t)
-        ExpectRelativelyClose(a[s][t].magnitude, b[s][t].magnitude, 1e-9, cuda->Name() + " magnitude");
-    morea_test::RandomCandidates onCpu(problem, population, problem.parallel.groups[0], 1.5, 43);
-    morea_test::RandomCandidates onGpu(problem, population, problem.parallel.groups[0], 1.5, 43);
-    cpu->EvaluatePartials(onCpu.candidates);
-    cuda->EvaluatePartials(onGpu.candidates);
-    for (std::size_t i = 0; i < onCpu.candidates.size(); ++i)
-      for (std::size_t t = 0; t < onCpu.values[i].size(); ++t)
-        ExpectRelativelyClose(onCpu.values[i][t].magnitude, onGpu.values[i][t].magnitude, 1e-9,
-                              cuda->Name() + " candidate magnitude");
-  }
-}
-
 // Rigid structures add their term to the magnitude on the device as on the
 // CPU: whole solutions and partial candidates on both paths, and the
 // refusal screen's bound (which sums the magnitude on the device) changes no

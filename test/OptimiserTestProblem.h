@@ -143,7 +143,7 @@ struct OptimiserTestProblem
    *  evaluator then adds the rigidity term with `weight`, and with a
    *  `strainLimit` its constraint. */
   void
-  UseRigidSlab(double weight = 1000.0, double strainLimit = 0.0, double smoothness = 0.0)
+  UseRigidSlab(double weight = 1000.0, double strainLimit = 0.0)
   {
     std::vector<double> fraction(topology.NumberOfTetrahedra(), 0.0);
     for (std::size_t t = 0; t < fraction.size(); ++t)
@@ -153,7 +153,7 @@ struct OptimiserTestProblem
         x += 0.25 * base.points[p][0];
       fraction[t] = x < 10.0 ? 1.0 : x < 15.0 ? 0.5 : 0.0;
     }
-    rigidity = morea_core::BuildRigidityModel(base, fraction, weight, strainLimit, smoothness);
+    rigidity = morea_core::BuildRigidityModel(base, fraction, weight, strainLimit);
     evaluator = std::make_unique<morea_core::TetrahedronEvaluator>(topology, *constraint, elasticity, rigidity, data);
   }
 

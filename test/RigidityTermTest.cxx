@@ -136,54 +136,6 @@ TEST(RigidityTerm, OnlyRigidTetrahedraCountByTheirShareAndWeight)
   EXPECT_THROW(BuildRigidityModel(mesh, { 1.0 }, 1.0), Error);
 }
 
-TEST(RigidityTerm, TheSmoothnessTermCostsRotationsAndStretchesButNotAMotionOfBothMeshes)
-{
-  const TetrahedralMesh mesh = Box();
-  const RigidityModel   model = BuildRigidityModel(mesh, {}, 1000.0, 0.0, 2.0);
-  ASSERT_FALSE(model.Empty());
-  ASSERT_EQ(model.smoothWeights.size(), mesh.NumberOfTetrahedra());
-  for (std::size_t t = 0; t < mesh.NumberOfTetrahedra(); ++t)
-  {
-    EXPECT_GT(model.smoothWeights[t], 0.0) << t;
-    EXPECT_EQ(model.weights[t], 0.0) << t; // no rigid structure
-  }
-  EXPECT_TRUE(model.limitVolumes.empty());
-  const auto & base = mesh.points;
-  const auto   motion = [](const Vec3 & p) { return RigidMotion(p, 0.7, { { 5.0, -3.0, 12.0 } }); };
-  const auto   rotated = Moved(base, motion);
-  const auto   shifted = Moved(base, [](const Vec3 & p) { return Vec3{ { p[0] + 4.0, p[1] - 2.0, p[2] } }; });
-  // Both meshes moved alike, or one shifted: the map is the base map up to a
-  // translation, which costs nothing.
-  EXPECT_LT(Total(model, mesh, rotated, rotated), 1e-18);
-  EXPECT_LT(Total(model, mesh, base, shifted), 1e-18);
-  // One mesh rotated against the other: the rigid term allows it, this one does not.
-  const double rotation = Total(model, mesh, base, rotated);
-  EXPECT_GT(rotation, 1.0);
-  const RigidityModel rigidOnly = BuildRigidityModel(mesh, std::vector<double>(mesh.NumberOfTetrahedra(), 1.0), 1000.0);
-  EXPECT_LT(Total(rigidOnly, mesh, base, rotated), 1e-18);
-  // A larger rotation and a growth cost; twice the weight, twice the cost.
-  EXPECT_GT(Total(model, mesh, base, Moved(base, [](const Vec3 & p) { return RigidMotion(p, 1.4, {}); })), rotation);
-  const auto grown = Moved(base, [](const Vec3 & p) { return Vec3{ { 1.05 * p[0], 1.05 * p[1], 1.05 * p[2] } }; });
-  EXPECT_GT(Total(model, mesh, base, grown), 0.0);
-  const RigidityModel doubled = BuildRigidityModel(mesh, {}, 1000.0, 0.0, 4.0);
-  EXPECT_NEAR(Total(doubled, mesh, base, rotated), 2.0 * rotation, 1e-9 * rotation);
-
-  // With rigid structures too, both terms add up.
-  std::vector<double> fraction(mesh.NumberOfTetrahedra(), 0.0);
-  fraction[3] = 1.0;
-  const RigidityModel both = BuildRigidityModel(mesh, fraction, 10.0, 0.0, 2.0);
-  const RigidityModel rigid = BuildRigidityModel(mesh, fraction, 10.0);
-  const auto          bent = Moved(base, [](const Vec3 & p) {
-    return Vec3{ { p[0], p[1], p[2] + 2.0 * (p[0] / 40.0) * (p[0] / 40.0) } };
-  });
-  EXPECT_NEAR(Total(both, mesh, base, bent), Total(rigid, mesh, base, bent) + Total(model, mesh, base, bent),
-              1e-9 * Total(both, mesh, base, bent));
-  // Off unless asked for; a negative weight is refused.
-  EXPECT_TRUE(BuildRigidityModel(mesh, {}, 1000.0).Empty());
-  EXPECT_TRUE(rigid.smoothWeights.empty());
-  EXPECT_THROW(BuildRigidityModel(mesh, {}, 1000.0, 0.0, -1.0), Error);
-}
-
 TEST(RigidityTerm, TheStrainLimitViolatesLikeAFoldOnlyBeyondItAndOnlyInsideRigidStructures)
 {
   const TetrahedralMesh mesh = Box();
@@ -292,5 +244,4 @@ TEST(RigidityTerm, CheckpointsOfOtherRigidSettingsAreRefusedNamingTheKey)
   };
   EXPECT_EQ(firstDifference("morea_rigid_structures", "none").rfind("morea_rigid_structures: \"auto\" in the checkpoint", 0), 0u);
   EXPECT_EQ(firstDifference("morea_rigid_weight", "10").rfind("morea_rigid_weight: 1000 in the checkpoint, 10 in this run", 0), 0u);
-  EXPECT_EQ(firstDifference("morea_smoothness_weight", "1").rfind("morea_smoothness_weight: 0 in the checkpoint, 1 in this run", 0), 0u);
 }

@@ -36,13 +36,6 @@ struct RigidityModel
    *  alone lets the solutions at the front's best-guidance end bend bones. */
   std::vector<double> limitVolumes;
   double              strainLimitSquared{ 0.0 };
-  /** The smoothness term (morea_smoothness_weight; empty when off): per
-   *  tetrahedron weight * |base volume| / l. It measures how far the two
-   *  meshes' deformations differ, ||G_target - G_source||_F^2, which the edge
-   *  term leaves free where a map rotates tissue, e.g. slides an organ's wall
-   *  along its contour. When on, `weights` and `inverseEdges` cover every
-   *  tetrahedron (weights 0 outside rigid structures). */
-  std::vector<double> smoothWeights;
 
   bool
   Empty() const
@@ -52,11 +45,10 @@ struct RigidityModel
 };
 
 /** The model for `base` with `rigidFraction[t]` of tetrahedron t inside a
- *  rigid structure (empty `rigidFraction`: none); empty when neither a rigid
- *  structure with a positive `weight` nor a positive `smoothWeight` is given. */
+ *  rigid structure; empty when no fraction is positive or `weight` is 0. */
 RigidityModel
 BuildRigidityModel(const TetrahedralMesh & base, const std::vector<double> & rigidFraction, double weight,
-                   double strainLimit = 0.0, double smoothWeight = 0.0);
+                   double strainLimit = 0.0);
 
 /** ||E_target - E_source||_F^2: E = (G^T G - I) / 2 is the Green strain of a
  *  mesh's tetrahedron against the base one (G = D B^-1, D its edge matrix),
@@ -68,15 +60,7 @@ double
 TetrahedronRigidDeviation(const std::array<Vec3, 4> & source, const std::array<Vec3, 4> & target,
                           const double inverseEdges[9]);
 
-/** ||G_target - G_source||_F^2 with G = D B^-1 each mesh's deformation
- *  gradient against the base tetrahedron: 0 exactly when the two meshes'
- *  tetrahedra differ by a translation, so a rotation costs too. */
-double
-TetrahedronGradientDifference(const std::array<Vec3, 4> & source, const std::array<Vec3, 4> & target,
-                              const double inverseEdges[9]);
-
-/** The rigidity term of tetrahedron t: weights[t] * deviation plus
- *  smoothWeights[t] * gradient difference; 0 for an empty model. */
+/** The rigidity term of tetrahedron t: weights[t] * deviation; 0 for an empty model. */
 double
 TetrahedronRigidity(const RigidityModel & model, std::size_t t, const std::array<Vec3, 4> & source,
                     const std::array<Vec3, 4> & target);

@@ -97,10 +97,6 @@ MakeSpecs()
          "largest strain (Frobenius norm of the Green strain's change) a tetrahedron inside a rigid structure may "
          "take; beyond it the solution counts as violating the constraint, like a fold (0: no limit; 0.03 keeps "
          "bones within 0.1 mm at the paper's budget, but slows short runs)"),
-    Real("morea_smoothness_weight", 0.0, 0.0, 1e9,
-         "weight of a smoothness term in the deformation magnitude: per tetrahedron the squared difference of the "
-         "two meshes' deformation gradients, so that rotating or sliding tissue costs too (0: off, the paper's "
-         "objective)"),
     Int("morea_max_num_mesh_levels", 1, 1, 6,
         "mesh resolution levels: after each level but the last the mesh is refined where the images, contours "
         "or strain still disagree, and every solution carries over (1: one mesh throughout)"),

@@ -60,22 +60,18 @@ Lower(std::string s)
 
 RigidityModel
 BuildRigidityModel(const TetrahedralMesh & base, const std::vector<double> & rigidFraction, double weight,
-                   double strainLimit, double smoothWeight)
+                   double strainLimit)
 {
   const std::size_t n = base.NumberOfTetrahedra();
-  if (!rigidFraction.empty() && rigidFraction.size() != n)
+  if (rigidFraction.size() != n)
     throw Error("rigidity: " + std::to_string(rigidFraction.size()) + " fractions for " + std::to_string(n) +
                 " tetrahedra");
   if (!(weight >= 0.0) || !std::isfinite(weight))
     throw Error("rigidity: the weight must be finite and non-negative");
   if (!(strainLimit >= 0.0) || !std::isfinite(strainLimit))
     throw Error("rigidity: the strain limit must be finite and non-negative");
-  if (!(smoothWeight >= 0.0) || !std::isfinite(smoothWeight))
-    throw Error("smoothness: the weight must be finite and non-negative");
   RigidityModel model;
-  const bool    rigid =
-    weight > 0.0 && std::any_of(rigidFraction.begin(), rigidFraction.end(), [](double f) { return f > 0.0; });
-  if (!rigid && smoothWeight == 0.0)
+  if (weight == 0.0 || std::none_of(rigidFraction.begin(), rigidFraction.end(), [](double f) { return f > 0.0; }))
     return model;
   double meanVolume = 0.0;
   for (const Tetrahedron & t : base.tetrahedra)
@@ -83,26 +79,16 @@ BuildRigidityModel(const TetrahedralMesh & base, const std::vector<double> & rig
   const double length = std::cbrt(meanVolume);
   model.weights.assign(n, 0.0);
   model.inverseEdges.assign(9 * n, 0.0);
-  if (smoothWeight > 0.0)
-    model.smoothWeights.assign(n, 0.0);
   for (std::size_t t = 0; t < n; ++t)
   {
     const Tetrahedron & tet = base.tetrahedra[t];
     const std::array<Vec3, 4> corners{ base.points[tet[0]], base.points[tet[1]], base.points[tet[2]],
                                        base.points[tet[3]] };
-    const double        fraction = rigid ? rigidFraction[t] : 0.0;
-    if (fraction <= 0.0 && smoothWeight == 0.0)
-      continue;
     // A degenerate base tetrahedron has no strain to measure: it keeps weight 0.
-    if (!InvertEdges(corners, &model.inverseEdges[9 * t]))
-      continue;
-    const double volumeOverLength = std::abs(SignedVolume(tet, base.points)) / length;
-    if (fraction > 0.0)
-      model.weights[t] = weight * fraction * volumeOverLength;
-    if (smoothWeight > 0.0)
-      model.smoothWeights[t] = smoothWeight * volumeOverLength;
+    if (rigidFraction[t] > 0.0 && InvertEdges(corners, &model.inverseEdges[9 * t]))
+      model.weights[t] = weight * rigidFraction[t] * std::abs(SignedVolume(tet, base.points)) / length;
   }
-  if (rigid && strainLimit > 0.0)
+  if (strainLimit > 0.0)
   {
     model.strainLimitSquared = strainLimit * strainLimit;
     model.limitVolumes.assign(n, 0.0);
@@ -134,30 +120,12 @@ TetrahedronRigidDeviation(const std::array<Vec3, 4> & source, const std::array<V
 }
 
 double
-TetrahedronGradientDifference(const std::array<Vec3, 4> & source, const std::array<Vec3, 4> & target,
-                              const double inverseEdges[9])
-{
-  double gs[9], gt[9];
-  StrainGradient(source, inverseEdges, gs);
-  StrainGradient(target, inverseEdges, gt);
-  double sum = 0.0;
-  for (int k = 0; k < 9; ++k)
-    sum += (gt[k] - gs[k]) * (gt[k] - gs[k]);
-  return sum;
-}
-
-double
 TetrahedronRigidity(const RigidityModel & model, std::size_t t, const std::array<Vec3, 4> & source,
                     const std::array<Vec3, 4> & target)
 {
-  if (model.Empty())
+  if (model.Empty() || model.weights[t] == 0.0)
     return 0.0;
-  double term = 0.0;
-  if (model.weights[t] != 0.0)
-    term += model.weights[t] * TetrahedronRigidDeviation(source, target, &model.inverseEdges[9 * t]);
-  if (!model.smoothWeights.empty() && model.smoothWeights[t] != 0.0)
-    term += model.smoothWeights[t] * TetrahedronGradientDifference(source, target, &model.inverseEdges[9 * t]);
-  return term;
+  return model.weights[t] * TetrahedronRigidDeviation(source, target, &model.inverseEdges[9 * t]);
 }
 
 double

@@ -49,8 +49,6 @@ CudaEvaluationBackend::CudaEvaluationBackend(const TetrahedronEvaluator & evalua
   {
     m_Constants.rigidWeights = Upload(evaluator.Rigidity().weights, m_RigidWeights);
     m_Constants.rigidInverseEdges = Upload(evaluator.Rigidity().inverseEdges, m_RigidInverseEdges);
-    if (!evaluator.Rigidity().smoothWeights.empty())
-      m_Constants.smoothWeights = Upload(evaluator.Rigidity().smoothWeights, m_SmoothWeights);
     if (!evaluator.Rigidity().limitVolumes.empty())
     {
       m_Constants.rigidLimitVolumes = Upload(evaluator.Rigidity().limitVolumes, m_RigidLimitVolumes);

@@ -702,7 +702,7 @@ private:
   cuda::DeviceArray<float>      m_Moving, m_Fixed, m_PackedMoving, m_PackedFixed;
   VolumeTextures m_MovingTextures, m_FixedTextures;
   cuda::DeviceArray<double>     m_GuidanceWeights, m_Elasticity, m_ReferenceVolumes;
-  cuda::DeviceArray<double>     m_RigidWeights, m_RigidInverseEdges, m_RigidLimitVolumes, m_SmoothWeights;
+  cuda::DeviceArray<double>     m_RigidWeights, m_RigidInverseEdges, m_RigidLimitVolumes;
   cuda::PinnedArray<double>        m_HostSolutionPoints; ///< whole solutions' points, staged
   cuda::DeviceArray<double>        m_SolutionPoints;
   // Partial candidates: the mesh once, then per batch (device and staging).

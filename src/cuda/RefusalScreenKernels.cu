@@ -94,7 +94,7 @@ ScreenCandidates(EvaluationConstants k, CandidateBatch batch, const double * __r
       const double * target = source + 12;
       const std::uint32_t t = tetrahedra[item];
       double              folded = 0.0;
-      sums[0] += ItemMagnitude(k.elasticity, k.rigidWeights, k.rigidInverseEdges, k.smoothWeights, t, source, target);
+      sums[0] += ItemMagnitude(k.elasticity, k.rigidWeights, k.rigidInverseEdges, t, source, target);
       sums[1] += SampleCount(k.samplingRate, k.voxelVolume, source) + SampleCount(k.samplingRate, k.voxelVolume, target);
       sums[2] += VolumeViolation(SignedVolume(source), k.referenceVolumes[t], k.volumeFraction, folded);
       sums[2] += VolumeViolation(SignedVolume(target), k.referenceVolumes[t], k.volumeFraction, folded);

@@ -220,39 +220,16 @@ TetrahedronRigidDeviation(const double s[12], const double t[12], const double *
   return sum;
 }
 
-/** TetrahedronGradientDifference of morea/RigidityTerm.h, in its order of operations. */
-inline __device__ double
-TetrahedronGradientDifference(const double s[12], const double t[12], const double * inverseEdges)
-{
-  double sum = 0.0;
-  for (int a = 0; a < 3; ++a)
-    for (int j = 0; j < 3; ++j)
-    {
-      double ss = 0.0, st = 0.0;
-      for (int e = 0; e < 3; ++e)
-      {
-        ss += (s[3 * (e + 1) + a] - s[a]) * inverseEdges[3 * e + j];
-        st += (t[3 * (e + 1) + a] - t[a]) * inverseEdges[3 * e + j];
-      }
-      sum += (st - ss) * (st - ss);
-    }
-  return sum;
-}
-
 /** A tetrahedron's whole magnitude term: its edges times its elasticity
- *  factor, plus its rigidity and smoothness terms (elasticity null: 1
- *  everywhere; rigidWeights null: neither term; smoothWeights null: no
- *  smoothness term). */
+ *  factor, plus its rigidity term (elasticity null: 1 everywhere;
+ *  rigidWeights null: no rigid structures). */
 inline __device__ double
 ItemMagnitude(const double * elasticity, const double * rigidWeights, const double * rigidInverseEdges,
-              const double * smoothWeights, std::uint32_t t, const double source[12], const double target[12])
+              std::uint32_t t, const double source[12], const double target[12])
 {
   double m = TetrahedronMagnitude(source, target, elasticity ? elasticity[t] : 1.0);
   if (rigidWeights != nullptr && rigidWeights[t] != 0.0)
     m += rigidWeights[t] * TetrahedronRigidDeviation(source, target, rigidInverseEdges + 9 * static_cast<std::size_t>(t));
-  if (smoothWeights != nullptr && smoothWeights[t] != 0.0)
-    m += smoothWeights[t] *
-         TetrahedronGradientDifference(source, target, rigidInverseEdges + 9 * static_cast<std::size_t>(t));
   return m;
 }
 
@@ -285,15 +262,15 @@ WarpSum(double x)
  *  strain limit's (RigidViolation). */
 inline __device__ void
 WriteItemValues(const double * referenceVolumes, double volumeFraction, const double * elasticity,
-                const double * rigidWeights, const double * rigidInverseEdges, const double * smoothWeights,
-                const double * rigidLimitVolumes, double rigidStrainLimitSquared, std::uint32_t t, const double source[12], const double target[12],
+                const double * rigidWeights, const double * rigidInverseEdges, const double * rigidLimitVolumes,
+                double rigidStrainLimitSquared, std::uint32_t t, const double source[12], const double target[12],
                 double * out)
 {
   double folded = 0.0;
   double value = VolumeViolation(SignedVolume(source), referenceVolumes[t], volumeFraction, folded);
   value += VolumeViolation(SignedVolume(target), referenceVolumes[t], volumeFraction, folded);
   value += RigidViolation(rigidLimitVolumes, rigidStrainLimitSquared, rigidInverseEdges, t, source, target, folded);
-  out[0] = ItemMagnitude(elasticity, rigidWeights, rigidInverseEdges, smoothWeights, t, source, target);
+  out[0] = ItemMagnitude(elasticity, rigidWeights, rigidInverseEdges, t, source, target);
   out[1] = value;
   out[2] = folded;
 }

@@ -242,7 +242,7 @@ EvaluateTetrahedraKernel(EvaluationConstants k, View moving, View fixed, const d
   if (direction == 0) // from = source, to = target
   {
     WriteItemValues(k.referenceVolumes, k.volumeFraction, k.elasticity, k.rigidWeights, k.rigidInverseEdges,
-                    k.smoothWeights, k.rigidLimitVolumes, k.rigidStrainLimitSquared,
+                    k.rigidLimitVolumes, k.rigidStrainLimitSquared,
                     tetrahedra[item], from, to, itemOut + item * ItemValues);
   }
 }

@@ -113,9 +113,6 @@ struct EvaluationConstants
    *  and 9 numbers of the base edge matrix's inverse; null without rigid structures. */
   const double *  rigidWeights{ nullptr };
   const double *  rigidInverseEdges{ nullptr };
-  /** The smoothness term's weight per tetrahedron (RigidityModel::smoothWeights;
-   *  it uses rigidInverseEdges); null without it. */
-  const double *  smoothWeights{ nullptr };
   /** The rigid strain limit's constraint: per tetrahedron its base volume
    *  where it holds (0 elsewhere), null without a limit; the limit squared. */
   const double *  rigidLimitVolumes{ nullptr };

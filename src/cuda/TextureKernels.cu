@@ -281,7 +281,7 @@ PrepareTextureTasks(EvaluationConstants k, const double * __restrict__ corners,
       itemIndex[item] = static_cast<std::uint32_t>(item);
 
     WriteItemValues(k.referenceVolumes, k.volumeFraction, k.elasticity, k.rigidWeights, k.rigidInverseEdges,
-                    k.smoothWeights, k.rigidLimitVolumes, k.rigidStrainLimitSquared,
+                    k.rigidLimitVolumes, k.rigidStrainLimitSquared,
                     tetrahedra[item], source, target, itemOut + item * ItemValues);
   }
   __syncthreads();

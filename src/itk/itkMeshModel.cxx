@@ -118,13 +118,10 @@ DeriveMeshModelParts(const RegistrationProblem & problem, const morea_core::Para
     rigidMasks.push_back(ToVolume(problem.GetStructure(name).movingMask.GetPointer(), model.frame));
     rigidMaskPointers.push_back(&rigidMasks.back());
   }
-  const double smoothness = parameters.GetReal("morea_smoothness_weight");
-  if (!rigidMaskPointers.empty() || smoothness > 0.0)
-    model.rigidity = morea_core::BuildRigidityModel(
-      model.base,
-      rigidMaskPointers.empty() ? std::vector<double>{}
-                                : morea_core::UnionOverlapFractions(model.base, rigidMaskPointers),
-      parameters.GetReal("morea_rigid_weight"), parameters.GetReal("morea_rigid_strain_limit"), smoothness);
+  if (!rigidMaskPointers.empty())
+    model.rigidity = morea_core::BuildRigidityModel(model.base, morea_core::UnionOverlapFractions(model.base, rigidMaskPointers),
+                                                 parameters.GetReal("morea_rigid_weight"),
+                                                 parameters.GetReal("morea_rigid_strain_limit"));
   model.report.secondsElasticity = SecondsSince(start);
 }
 } // namespace
