@@ -16,9 +16,10 @@ cd "$(dirname "$0")/.."
 DATA=${MOREA_DATA:-../shared/data/abdomen-cbct-pair}
 # Mesh level schedules by name: 1 (one mesh), 3 (600 points for 200
 # generations, ~1400 for 200, ~3200 for 100), 2a (600 for 400, ~1400 for
-# 100), 2b (600 for 450, ~3200 for 50), 2c (600 for 475, ~3200 for 25); a
-# trailing g (3g, 2g, 2bg) makes the refined levels' FOS elements groups of
-# points (morea_fos_type = coarse-groups); 2g: 600 for 250, ~3200 for 250.
+# 100), 2b (600 for 450, ~3200 for 50), 2c (600 for 475, ~3200 for 25), 2d
+# (600 for 485, ~3200 for 15); a trailing g (3g, 2g, 2bg) makes the refined
+# levels' FOS elements groups of points (morea_fos_type = coarse-groups); 2g:
+# 600 for 250, ~3200 for 250.
 schedule() {
   case "$1" in
     *g) echo "$(schedule "${1%g}") morea_fos_type=coarse-groups"; return ;;
@@ -29,6 +30,7 @@ schedule() {
     2a) echo morea_max_num_mesh_levels=2 morea_num_generations_per_level=400 morea_mesh_refinement_factor=2.3 ;;
     2b) echo morea_max_num_mesh_levels=2 morea_num_generations_per_level=450 morea_mesh_refinement_factor=5.3 ;;
     2c) echo morea_max_num_mesh_levels=2 morea_num_generations_per_level=475 morea_mesh_refinement_factor=5.3 ;;
+    2d) echo morea_max_num_mesh_levels=2 morea_num_generations_per_level=485 morea_mesh_refinement_factor=5.3 ;;
     2) echo morea_max_num_mesh_levels=2 morea_num_generations_per_level=250 morea_mesh_refinement_factor=5.3 ;;
     *) echo "unknown schedule $1" >&2; exit 2 ;;
   esac
