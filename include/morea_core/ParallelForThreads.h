@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cstddef>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -31,8 +32,18 @@ ParallelForOnNewThreads(std::size_t count, TBody body)
       body(item);
   };
   std::vector<std::thread> helpers;
+  helpers.reserve(threads - 1);
   for (std::size_t t = 1; t < threads; ++t)
-    helpers.emplace_back(worker);
+  {
+    try
+    {
+      helpers.emplace_back(worker);
+    }
+    catch (const std::system_error &)
+    {
+      break; // the system has no thread to spare now: the same items on fewer threads
+    }
+  }
   worker();
   for (auto & h : helpers)
     h.join();

@@ -2,6 +2,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // The `morea` command line: multi-objective deformable registration (MOREA).
 #include "CommandCommon.h"
+#include "CrashReport.h"
 
 #include "itkMacro.h"
 #include "morea_core/Error.h"
@@ -11,6 +12,7 @@
 int
 main(int argc, char ** argv)
 {
+  morea_cli::InstallCrashReport();
   CLI::App app{ "morea: multi-objective deformable registration of 3D images with large deformations" };
   app.require_subcommand(1);
   app.set_version_flag("--version", "morea 0.1.0");

@@ -4,14 +4,12 @@
 
 #include "morea_core/Error.h"
 #include "morea_core/Random.h"
-#include "morea_core/ThreadPool.h"
+#include "morea_core/ParallelForThreads.h"
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
 #include <limits>
 #include <string>
-#include <thread>
 
 namespace morea_core
 {
@@ -124,21 +122,6 @@ InBowelGas(const Vec3 & x, double lift)
   return false;
 }
 
-void
-ParallelFor(std::size_t count, const std::function<void(std::size_t)> & body)
-{
-  const std::size_t threads = std::max<std::size_t>(1, std::min<std::size_t>(count, HostThreads()));
-  std::vector<std::thread> pool;
-  for (std::size_t t = 0; t < threads; ++t)
-  {
-    pool.emplace_back([&, t] {
-      for (std::size_t i = t; i < count; i += threads)
-        body(i);
-    });
-  }
-  for (auto & th : pool)
-    th.join();
-}
 } // namespace
 
 PhantomOptions
@@ -419,7 +402,7 @@ PelvisPhantom::Generate() const
 
   // One pass per image; slices in parallel, noise seeded per slice so the
   // result does not depend on the number of threads.
-  ParallelFor(size[2], [&](std::size_t k) {
+  ParallelForOnNewThreads(size[2], [&](std::size_t k) {
     RandomGenerator fixedNoise(HashCombine(m_Options.seed, 2 * k));
     RandomGenerator movingNoise(HashCombine(m_Options.seed, 2 * k + 1));
     for (std::size_t j = 0; j < size[1]; ++j)

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <map>
+#include <system_error>
 
 #if defined(__x86_64__) || defined(__i386__)
 #  include <immintrin.h>
@@ -143,11 +144,21 @@ ThreadPool::ThreadPool(std::size_t threads, WorkerPriority priority)
 {
   if (threads == 0)
     threads = HostThreads();
+  m_Workers.reserve(threads - 1);
   for (std::size_t i = 1; i < threads; ++i)
-    m_Workers.emplace_back([this, priority] {
-      SetOwnPriority(priority);
-      WorkerLoop();
-    });
+  {
+    try
+    {
+      m_Workers.emplace_back([this, priority] {
+        SetOwnPriority(priority);
+        WorkerLoop();
+      });
+    }
+    catch (const std::system_error &)
+    {
+      break; // the system has no thread to spare now: a smaller pool, the same results
+    }
+  }
 }
 
 ThreadPool::~ThreadPool()

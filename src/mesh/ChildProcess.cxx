@@ -74,6 +74,10 @@ ChildMain(int fd, const std::function<std::string()> & work)
   // A crash here is expected now and then: no core file for it.
   struct rlimit noCore = { 0, 0 };
   ::setrlimit(RLIMIT_CORE, &noCore);
+  // Nor a crash report from a handler the parent installed: what the child
+  // printed last is what its parent keeps for the failure.
+  for (int signal : { SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT })
+    ::signal(signal, SIG_DFL);
   char        kind = 'K';
   std::string bytes;
   try

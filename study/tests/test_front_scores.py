@@ -13,6 +13,13 @@ import pytest
 from study import front_scores
 
 
+def _run(cmd):
+    """Runs a morea command; a failure shows its exit status and the end of its stderr."""
+    done = subprocess.run(cmd, capture_output=True, text=True)
+    if done.returncode != 0:
+        pytest.fail(f"{cmd[1]} exited with {done.returncode}: {done.stderr[-2000:]}")
+
+
 @pytest.fixture(scope="module")
 def registered(morea, translated_problem, tmp_path_factory):
     out = tmp_path_factory.mktemp("front") / "reg"
@@ -21,7 +28,7 @@ def registered(morea, translated_problem, tmp_path_factory):
     for kv in ("ea_population_size=16", "ea_num_generations=3", "ea_archive_size=40",
                "morea_mesh_num_points=40", "preprocess_rigid_structure=none", "seed=3"):
         cmd += ["--set", kv]
-    subprocess.run(cmd, check=True, capture_output=True)
+    _run(cmd)
     return out
 
 
@@ -37,9 +44,8 @@ def test_every_member_is_scored_in_guidance_order(morea, registered, tmp_path):
     # One member's row is what `morea evaluate` says of it.
     row = rows[-1]
     out = tmp_path / "one.json"
-    subprocess.run([morea, "evaluate", "--problem", str(problem), "--field",
-                    str(registered / f"solution_{row['id']}" / "preprocessed_fixed_to_moving.nii.gz"),
-                    "-o", str(out)], check=True, capture_output=True)
+    _run([morea, "evaluate", "--problem", str(problem), "--field",
+          str(registered / f"solution_{row['id']}" / "preprocessed_fixed_to_moving.nii.gz"), "-o", str(out)])
     one = json.loads(out.read_text())
     assert row["dice:ball"] == pytest.approx(one["structures"]["ball"]["dice"])
     assert row["jacobian_nonpositive_fraction"] == one["jacobian_nonpositive_fraction"]
