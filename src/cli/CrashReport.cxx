@@ -20,24 +20,22 @@ namespace morea_cli
 #if MOREA_HAVE_CRASH_REPORT
 namespace
 {
-constexpr int ReportedSignals[] = { SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT };
+struct ReportedSignal
+{
+  int          number;
+  const char * name;
+};
+constexpr ReportedSignal ReportedSignals[] = {
+  { SIGSEGV, "SIGSEGV" }, { SIGBUS, "SIGBUS" }, { SIGFPE, "SIGFPE" }, { SIGILL, "SIGILL" }, { SIGABRT, "SIGABRT" }
+};
 
 const char *
 SignalName(int signal)
 {
-  switch (signal)
-  {
-    case SIGSEGV:
-      return "SIGSEGV";
-    case SIGBUS:
-      return "SIGBUS";
-    case SIGFPE:
-      return "SIGFPE";
-    case SIGILL:
-      return "SIGILL";
-    default:
-      return "SIGABRT";
-  }
+  for (const auto & s : ReportedSignals)
+    if (s.number == signal)
+      return s.name;
+  return "?";
 }
 
 void
@@ -76,8 +74,8 @@ InstallCrashReport()
   action.sa_handler = ReportCrash;
   sigemptyset(&action.sa_mask);
   action.sa_flags = SA_RESETHAND | SA_NODEFER;
-  for (int signal : ReportedSignals)
-    ::sigaction(signal, &action, nullptr);
+  for (const auto & s : ReportedSignals)
+    ::sigaction(s.number, &action, nullptr);
 }
 #else
 void
